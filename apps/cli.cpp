@@ -1,0 +1,58 @@
+#include <cstdio>
+#include <exception>
+
+#include "apps/commands.hpp"
+#include "sim/scene_error.hpp"
+
+namespace dicesim {
+
+void SceneArgs::add_to(CLI::App* cmd) {
+  cmd->add_option("SCENE", path, "Scene file (TOML), e.g. scenes/paper/die1.toml")->required();
+  cmd->add_option("--set", overrides,
+                  "Override a scene key, KEY=VALUE in TOML syntax; repeatable.\n"
+                  "e.g. --set materials.steel.restitution=1.0 --set throw.spin.sd=30")
+      ->type_name("KEY=VALUE");
+  cmd->add_option("--fidelity", fidelity, "Physical model (the scene's sim.fidelity otherwise): paper")
+      ->type_name("F");
+}
+
+SceneDef SceneArgs::load() const {
+  std::vector<std::string> all = overrides;
+  if (!fidelity.empty()) all.push_back("sim.fidelity=\"" + fidelity + "\"");
+  return load_scene(path, all);
+}
+
+int run_cli(int argc, char** argv) {
+  CLI::App app{
+      "dicesim: how likely is each face of a real, possibly unfair die?\n"
+      "Simulates physical tosses (flight, bounces, rest) of a die of any density layout.\n\n"
+      "Start with:  dicesim toss scenes/paper/die1.toml\n"
+      "             dicesim info scenes/paper/die1.toml\n"
+      "Exit codes: 0 ok, 1 failed, 2 bad input (file, key, value or range named on stderr).",
+      "dicesim"};
+  app.require_subcommand(1);
+  app.fallthrough(false);
+  int exit_code = kExitOk;
+  register_toss(app, exit_code);
+  register_info(app, exit_code);
+  register_bench(app, exit_code);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "dicesim: %s\nRun with --help for usage.\n", e.what());
+    return kExitBadInput;
+  } catch (const SceneError& e) {
+    std::fprintf(stderr, "dicesim: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dicesim: failed: %s\n", e.what());
+    return kExitFailed;
+  }
+  return exit_code;
+}
+
+}  // namespace dicesim

@@ -1,0 +1,80 @@
+#include "apps/report.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <vector>
+
+#include "sim/statistics.hpp"
+
+namespace dicesim {
+namespace {
+
+struct FaceRow {
+  int label;
+  std::uint64_t count;
+  double p;
+  Interval ci;
+};
+
+std::vector<FaceRow> face_rows(const RunReport& r) {
+  std::vector<FaceRow> rows;
+  for (std::size_t i = 0; i < 6; ++i) {
+    const std::uint64_t c = r.counts.faces[i];
+    const double p = r.counts.settled ? static_cast<double>(c) / static_cast<double>(r.counts.settled) : 0.0;
+    rows.push_back({r.labels[i], c, p, wilson_interval(c, r.counts.settled)});
+  }
+  std::sort(rows.begin(), rows.end(), [](const FaceRow& a, const FaceRow& b) { return a.label < b.label; });
+  return rows;
+}
+
+double rate(const RunReport& r) { return r.elapsed_s > 0.0 ? static_cast<double>(r.tosses) / r.elapsed_s : 0.0; }
+
+}  // namespace
+
+nlohmann::json report_json(const RunReport& r) {
+  nlohmann::json faces = nlohmann::json::array();
+  for (const FaceRow& f : face_rows(r))
+    faces.push_back({{"face", f.label}, {"count", f.count}, {"p", f.p}, {"ci95", {f.ci.lo, f.ci.hi}}});
+  const ChiSquare chi = chi2_uniform(r.counts.faces);
+  return {{"scene", r.scene},
+          {"fidelity", r.fidelity},
+          {"seed", r.seed},
+          {"threads", r.threads},
+          {"tosses", r.tosses},
+          {"settled", r.counts.settled},
+          {"unresolved", r.counts.unresolved},
+          {"invalid", r.counts.invalid},
+          {"faces", faces},
+          {"chi2_uniform", {{"statistic", chi.statistic}, {"dof", chi.dof}, {"p_value", chi.p_value}}},
+          {"bounces_per_toss", r.tosses ? static_cast<double>(r.counts.bounces) / static_cast<double>(r.tosses) : 0.0},
+          {"elapsed_s", r.elapsed_s},
+          {"tosses_per_s", rate(r)}};
+}
+
+std::string report_table(const RunReport& r) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%s  (fidelity %s, seed %llu, %llu tosses, %d thread%s)\n\n", r.scene.c_str(),
+                r.fidelity.c_str(), static_cast<unsigned long long>(r.seed), static_cast<unsigned long long>(r.tosses),
+                r.threads, r.threads == 1 ? "" : "s");
+  out += line;
+  out += "face       count        p     95% interval (Wilson)\n";
+  for (const FaceRow& f : face_rows(r)) {
+    std::snprintf(line, sizeof line, "%4d  %10llu   %.5f   [%.5f, %.5f]\n", f.label,
+                  static_cast<unsigned long long>(f.count), f.p, f.ci.lo, f.ci.hi);
+    out += line;
+  }
+  std::snprintf(line, sizeof line, "\nsettled %llu, unresolved %llu, invalid %llu (p and intervals over settled tosses)\n",
+                static_cast<unsigned long long>(r.counts.settled), static_cast<unsigned long long>(r.counts.unresolved),
+                static_cast<unsigned long long>(r.counts.invalid));
+  out += line;
+  const ChiSquare chi = chi2_uniform(r.counts.faces);
+  std::snprintf(line, sizeof line, "chi-square vs a fair die: %.2f on %d dof, p = %.3g\n", chi.statistic, chi.dof, chi.p_value);
+  out += line;
+  std::snprintf(line, sizeof line, "%.3f s, %.0f tosses/s, %.2f impacts per toss\n", r.elapsed_s, rate(r),
+                r.tosses ? static_cast<double>(r.counts.bounces) / static_cast<double>(r.tosses) : 0.0);
+  out += line;
+  return out;
+}
+
+}  // namespace dicesim

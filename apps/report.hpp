@@ -1,0 +1,31 @@
+// What a run prints: an aligned table for people, one JSON object for scripts.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "sim/die_model.hpp"
+#include "sim/monte_carlo.hpp"
+
+namespace dicesim {
+
+struct RunReport {
+  std::string scene;
+  std::string fidelity;
+  std::uint64_t seed = 0;
+  int threads = 1;
+  std::uint64_t tosses = 0;
+  RunCounts counts;
+  std::array<int, 6> labels{};  // face label per face index
+  double elapsed_s = 0.0;
+};
+
+// {"scene", "fidelity", "seed", "threads", "tosses", "settled", "unresolved", "invalid",
+//  "faces": [{"face", "count", "p", "ci95": [lo, hi]}], "chi2_uniform": {"statistic", "p_value"},
+//  "elapsed_s", "tosses_per_s"} -- p and intervals over settled tosses, faces by label.
+nlohmann::json report_json(const RunReport& r);
+std::string report_table(const RunReport& r);
+
+}  // namespace dicesim

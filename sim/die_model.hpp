@@ -1,0 +1,46 @@
+// The compiled, immutable die (as MuJoCo's mjModel): everything a toss reads, computed once
+// from a SceneDef. Body frame = principal frame with origin at the centre of mass.
+#pragma once
+
+#include <array>
+#include <string>
+
+#include "sim/mass_properties.hpp"
+#include "sim/math.hpp"
+#include "sim/scene.hpp"
+
+namespace dicesim {
+
+struct DieModel {
+  // Geometry in the body (principal, COM-centred) frame.
+  std::array<Vec3, 8> vertices;        // box corners; index bit k set <=> + side along geometric axis k
+  std::array<Vec3, 6> face_normals;    // outward, order +x, -x, +y, -y, +z, -z of the geometric frame
+  std::array<int, 6> face_labels;      // label of each face in that order
+  std::array<double, 8> vertex_restitution;  // per corner: volume-weighted over the corner's materials
+  std::array<double, 8> vertex_friction;
+  double bounding_radius = 0.0;        // max |vertex| from the COM
+
+  // Mass properties.
+  double mass = 0.0;
+  Vec3 principal_moments = Vec3::Ones();  // ascending
+  MassProperties mass_geometric;          // the same in the geometric frame (for `info`)
+  // geometric frame -> body frame: x_body = geo_to_body * (x_geo - com_geo)
+  Mat3 geo_to_body = Mat3::Identity();
+  bool symmetric_top = false;
+
+  // Simulation settings, copied from the scene.
+  Fidelity fidelity = Fidelity::Paper;
+  double gravity = 9.81;
+  double stop_speed = 0.1;
+  int max_bounces = 1000;
+  double max_time = 60.0;
+
+  ThrowDef throw_;  // distributions of the initial state (geometric frame for orientation)
+  std::string name;
+};
+
+// Compiles a validated scene. Throws SceneError for a die that cannot be simulated
+// (zero mass, a region covering nothing, ...).
+DieModel compile(const SceneDef& scene, const std::string& origin = "scene");
+
+}  // namespace dicesim

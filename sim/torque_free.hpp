@@ -1,0 +1,94 @@
+// Torque-free rotation of a rigid body between contacts: exact, closed form.
+// World angular momentum L is constant; the body frame here is the principal frame
+// (inertia diagonal, moments I1 <= I2 <= I3). Symmetric tops use regular precession;
+// the general case uses Jacobi elliptic functions and the elliptic integral of the
+// third kind (Carlson form, Boost.Math) for the precession angle, so energy and |L| are conserved to
+// rounding at any spin and any flight time.
+#pragma once
+
+#include "sim/math.hpp"
+
+namespace dicesim {
+
+class TorqueFreeRotation {
+ public:
+  TorqueFreeRotation() = default;
+  // moments: principal moments (ascending, > 0); R0: principal->world rotation at t = 0;
+  // L_world: angular momentum in world coordinates (constant).
+  TorqueFreeRotation(const Vec3& moments, const Mat3& R0, const Vec3& L_world);
+
+  // Orientation (principal->world) at time t >= 0 after the start.
+  Mat3 orientation(double t) const;
+  // Orientation and world angular velocity at time t.
+  void state(double t, Mat3& R, Vec3& omega_world) const;
+
+  const Vec3& angular_momentum() const { return L_; }
+  // Upper bounds over all t: |omega| and |d omega/dt| (for conservative contact advancement).
+  double max_omega() const { return max_omega_; }
+  double max_alpha() const { return max_alpha_; }
+  bool symmetric() const { return kind_ != Kind::General; }
+
+ private:
+  enum class Kind { Still, SymmetricTop, General };
+  Kind kind_ = Kind::Still;
+  Vec3 I_ = Vec3::Ones();
+  Mat3 R0_ = Mat3::Identity();
+  Vec3 L_ = Vec3::Zero();
+  double max_omega_ = 0.0, max_alpha_ = 0.0;
+  // Regular precession (Landau-Lifshitz §33, §35): R(t) = Rot(L^, |L| t / I_perp) R0 Rot(e_a, spin_rate t).
+  // Rot(L^, alpha) R0 = along + cos(alpha) across + sin(alpha) cross (Rodrigues, precomputed).
+  // Also used for a steady rotation about a principal axis of an asymmetric body.
+  struct Symmetric {
+    int axis = 2;                // symmetry axis a (principal-frame index)
+    int p = 0, q = 1;            // the other two axes, (a, p, q) cyclic
+    double precession_rate = 0;  // |L| / I_perp, about L^
+    double spin_rate = 0;        // (1/I_a - 1/I_perp) L_a, about the body axis a (L_a constant)
+    double inv_I_perp = 0;       // 1 / I_perp
+    Mat3 along = Mat3::Zero();   // L^ L^T R0
+    Mat3 across = Mat3::Zero();  // R0 - L^ L^T R0
+    Mat3 cross = Mat3::Zero();   // [L^]x R0
+  } sym_;
+
+  // Asymmetric top: Jacobi's solution (Landau-Lifshitz §37), see torque_free.cpp for the formulas.
+  // Body axes: d = the axis L_b circles (never crosses zero), m = the middle moment, c = the
+  // other one; L_c = P cn(u), L_m = Q sn(u), L_d = D dn(u) with u = lambda t + u0.
+  static constexpr int kMaxLandenLevels = 24;
+  struct General {
+    bool steady = false;      // L along a principal axis exactly: evaluated through sym_
+    bool separatrix = false;  // k == 1 exactly: sn = tanh, cn = dn = sech, no period
+    int c = 0, m = 1, d = 2;  // body indices as above
+    int x = 0, y = 1;         // relabelled frame (x, y, d) is cyclic: body indices of x and y
+    double P = 0, Q = 0, D = 0;          // amplitudes of L_c, L_m, L_d
+    double q_ratio = 0;                  // Q / P, finite even when P -> 0
+    double sign_P = 1;                   // sign of P (only -1 on the separatrix)
+    double k2 = 0, kc2 = 1;              // k^2 and k'^2 = 1 - k^2, each computed without cancellation
+    double lambda = 0, u0 = 0;           // u = lambda t + u0
+    double two_K = 0, inv_two_K = 0;     // half period 2K(k) in u
+    double n_prime = 0;                  // Pi characteristic: (1/I_c - 1/I_m) / (1/I_m - 1/I_d)
+    double two_fK = 0, f0 = 0;           // precession integral over 2K, and at u0
+    double phi_rate = 0;                 // |L| / I_c
+    double phi_coeff = 0;                // |L| (1/I_c - 1/I_d) / lambda
+    Vec3 inv_I = Vec3::Ones();           // 1 / moments
+    Mat3 frame = Mat3::Identity();       // F: fixed world frame, third column L^, R(t) = F Rz(phi) B(t)
+    // Descending Landen transformation (A&S 16.12) from k down to a negligible modulus.
+    int landen_levels = 0;
+    double landen_scale = 1;             // prod 1 / (1 + k_n): sn(u|k) from sin(u * scale)
+    double landen_k[kMaxLandenLevels] = {};          // k_n, n = 1..levels
+    double landen_one_minus_k[kMaxLandenLevels] = {};  // 1 - k_n, accurate near k_n = 1
+  } gen_;
+
+  struct JacobiState {
+    double sn, cn, dn;  // at u = lambda t + u0
+    double f;           // precession integral f(u) (see torque_free.cpp)
+  };
+  void init_symmetric(int axis, double inv_I_axis, double inv_I_perp, const Vec3& L_body);
+  void init_general(const Vec3& L_body);
+  JacobiState jacobi_state(double t) const;
+  Mat3 symmetric_orientation(double t) const;
+  Mat3 general_orientation(double t, Vec3* L_body) const;
+};
+
+// True when two principal moments agree within a relative 1e-12 (closed-form symmetric top).
+bool is_symmetric_top(const Vec3& moments);
+
+}  // namespace dicesim

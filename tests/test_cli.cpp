@@ -1,0 +1,131 @@
+// The `dicesim` command line as a user meets it: output formats, exit codes, error messages.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+struct CliRun {
+  int code = -1;
+  std::string out, err;
+};
+
+CliRun dicesim(const std::string& args) {
+  const std::string err_file = ::testing::TempDir() + "dicesim_cli_stderr.txt";
+  const std::string cmd = std::string("cd ") + DICESIM_SOURCE_DIR + " && " + DICESIM_BINARY + " " + args + " 2>" + err_file;
+  CliRun r;
+  FILE* p = popen(cmd.c_str(), "r");
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream e(err_file);
+  std::stringstream ss;
+  ss << e.rdbuf();
+  r.err = ss.str();
+  return r;
+}
+
+void expect_bad_input(const CliRun& r, std::initializer_list<const char*> mentions) {
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(r.out.empty()) << "stdout must stay empty on bad input: " << r.out;
+  for (const char* m : mentions) EXPECT_NE(r.err.find(m), std::string::npos) << "stderr lacks '" << m << "': " << r.err;
+}
+
+}  // namespace
+
+TEST(Cli, TossJsonIsOneObjectWithEveryKey) {
+  const CliRun r = dicesim("toss scenes/paper/die1.toml --tosses 3000 --seed 5 --threads 2 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);  // throws if there is anything but one object
+  for (const char* k : {"scene", "fidelity", "seed", "threads", "tosses", "settled", "unresolved", "invalid", "faces",
+                        "chi2_uniform", "elapsed_s", "tosses_per_s"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  EXPECT_EQ(j["fidelity"], "paper");
+  EXPECT_EQ(j["tosses"], 3000);
+  EXPECT_EQ(j["settled"].get<int>() + j["unresolved"].get<int>() + j["invalid"].get<int>(), 3000);
+  ASSERT_EQ(j["faces"].size(), 6u);
+  int sum = 0;
+  for (int i = 0; i < 6; ++i) {
+    const auto& f = j["faces"][i];
+    EXPECT_EQ(f["face"], i + 1);
+    sum += f["count"].get<int>();
+    EXPECT_LE(f["ci95"][0].get<double>(), f["p"].get<double>());
+    EXPECT_GE(f["ci95"][1].get<double>(), f["p"].get<double>());
+  }
+  EXPECT_EQ(sum, j["settled"].get<int>());
+  EXPECT_TRUE(j["chi2_uniform"].contains("statistic"));
+  EXPECT_TRUE(j["chi2_uniform"].contains("p_value"));
+}
+
+TEST(Cli, CountsDoNotDependOnThreads) {
+  const auto counts = [](const std::string& threads) {
+    const CliRun r = dicesim("toss scenes/paper/die2.toml --tosses 5000 --seed 9 --json --threads " + threads);
+    EXPECT_EQ(r.code, 0) << r.err;
+    return nlohmann::json::parse(r.out)["faces"].dump();
+  };
+  EXPECT_EQ(counts("1"), counts("2"));
+}
+
+TEST(Cli, TableIsReadable) {
+  const CliRun r = dicesim("toss scenes/fair.toml --tosses 1000");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("95% interval"), std::string::npos);
+  EXPECT_NE(r.out.find("settled"), std::string::npos);
+}
+
+TEST(Cli, InfoJsonHasMassProperties) {
+  const CliRun r = dicesim("info scenes/paper/die3.toml --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["mass"].get<double>(), 0.0);
+  EXPECT_EQ(j["com"].size(), 3u);
+  ASSERT_EQ(j["inertia"].size(), 3u);
+  EXPECT_EQ(j["inertia"][0].size(), 3u);
+  EXPECT_NE(j["inertia"][0][2].get<double>(), 0.0);  // the diagonal cut has products of inertia
+  EXPECT_EQ(j["principal_moments"].size(), 3u);
+}
+
+TEST(Cli, HelpTeaches) {
+  const CliRun r = dicesim("toss --help");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("--tosses"), std::string::npos);
+  EXPECT_NE(r.out.find("--set"), std::string::npos);
+  EXPECT_NE(r.out.find("Example"), std::string::npos);
+}
+
+TEST(Cli, MissingFile) { expect_bad_input(dicesim("toss scenes/nope.toml"), {"scenes/nope.toml"}); }
+
+TEST(Cli, UnknownKey) {
+  expect_bad_input(dicesim("toss scenes/paper/die1.toml --set materials.steel.densty=1"), {"densty"});
+}
+
+TEST(Cli, NegativeDensity) {
+  expect_bad_input(dicesim("toss scenes/paper/die1.toml --set materials.steel.density=-5"),
+                   {"die1.toml", "materials.steel.density", "-5"});
+}
+
+TEST(Cli, RestitutionOutOfRange) {
+  expect_bad_input(dicesim("toss scenes/paper/die1.toml --set materials.aluminium.restitution=1.5"),
+                   {"materials.aluminium.restitution", "1.5"});
+}
+
+TEST(Cli, NotANumber) { expect_bad_input(dicesim("toss scenes/paper/die1.toml --set throw.height.mean=nan"), {"throw.height.mean"}); }
+
+TEST(Cli, WrongType) { expect_bad_input(dicesim("toss scenes/paper/die1.toml --set sim.stop_speed='\"fast\"'"), {"sim.stop_speed"}); }
+
+TEST(Cli, DieBelowTheFloor) {
+  expect_bad_input(dicesim("toss scenes/paper/die1.toml --set throw.height.mean=0.001"), {"throw.height.mean", "floor"});
+}
+
+TEST(Cli, UnknownFidelity) { expect_bad_input(dicesim("toss scenes/paper/die1.toml --fidelity warp"), {"warp"}); }
+
+TEST(Cli, BadOption) { expect_bad_input(dicesim("toss scenes/paper/die1.toml --tosses -3"), {}); }
