@@ -32,11 +32,14 @@ ContactSearch Flight::next_contact(double t_limit) const {
   const double A = accel_bound_;
   ContactSearch out;
 
-  // No vertex can touch while the COM is higher than the bounding radius: jump there in closed
-  // form (the whole free fall of a high throw costs one square root).
-  double t = 0.0;
+  // No vertex can touch while the COM is higher than the bounding radius: whenever it is, jump
+  // in closed form to the time it comes back down to that height (the whole free fall of a high
+  // throw, or the rise and fall after a strong bounce, costs one square root).
+  // sphere_time: the later root of z_com(t) = bounding radius, when the COM is on its way down.
   const double clear = p0_.z() - model_->bounding_radius;
-  if (clear > 0.0) t = (v0_.z() + std::sqrt(v0_.z() * v0_.z() + 2.0 * g * clear)) / g;
+  const double disc = v0_.z() * v0_.z() + 2.0 * g * clear;
+  const double sphere_time = disc >= 0.0 ? (v0_.z() + std::sqrt(disc)) / g : 0.0;
+  double t = clear > 0.0 ? sphere_time : 0.0;
 
   // Second-order conservative advancement: vertex i satisfies
   //   z_i(t + s) >= z_i + zdot_i s - A s^2 / 2,
@@ -56,6 +59,10 @@ ContactSearch Flight::next_contact(double t_limit) const {
     rotation_.state(t, R, w);
     const double zc = p0_.z() + v0_.z() * t - 0.5 * g * t * t;
     const double vz = v0_.z() - g * t;
+    if (zc > model_->bounding_radius && sphere_time > t) {
+      t = sphere_time;
+      continue;
+    }
 
     double step = std::numeric_limits<double>::infinity();
     int touching = -1;

@@ -233,8 +233,9 @@ MassProperties compute_mass_properties(const DieDef& die, const std::map<std::st
 
   MassProperties mp;
   mp.mass = mass_moments.volume;
-  if (!(mp.mass > 0.0) || !std::isfinite(mp.mass))
-    throw std::invalid_argument("mass properties: the die's mass is not positive; check its size and densities");
+  // No mass (a zero-size die): nothing else is defined. Report the mass alone and leave the rest at
+  // its defaults; the caller rejects it with a message naming the scene key (die_model.cpp, compile).
+  if (!(mp.mass > 0.0) || !std::isfinite(mp.mass)) return mp;
   mp.com = mass_moments.first / mp.mass;
   // Parallel-axis theorem on the second moment, then I = tr(S) 1 - S (already density-weighted).
   const Mat3 second_about_com = mass_moments.second - mp.mass * mp.com * mp.com.transpose();

@@ -31,14 +31,20 @@
 // and f(u + 2K j) = f(u) + j f(2K) unwraps it over whole half periods so phi is continuous for all t.
 // R(t) = F Rz(phi(t) - phi(0)) B(t), where B(t) (body -> frame with z along L_b) holds the angles
 // theta and psi, and the fixed world frame F = R0 B(0)^T makes R(0) = R0 to rounding.
+//
+// sn, cn, dn come from the descending Landen transformation (A&S 16.12) fed with k^2 and k'^2
+// separately, not from boost::math::jacobi_elliptic: that takes the modulus k alone, so k' is lost
+// once k' < 1e-8 (k rounds to 1), e.g. a die spun about its middle axis with a 1e-7 perturbation
+// would never flip. The ladder depends on k only, so it is built once and each call costs one
+// sincos and a few divisions. The separatrix itself (k' = 0 exactly) uses sn = tanh, cn = dn = sech.
 #include "sim/torque_free.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 
 #include <boost/math/policies/policy.hpp>
 #include <boost/math/special_functions/ellint_rf.hpp>
-#include <boost/math/special_functions/ellint_rj.hpp>
 
 namespace dicesim {
 namespace {
@@ -48,8 +54,54 @@ namespace {
 using CarlsonPolicy = boost::math::policies::policy<boost::math::policies::promote_double<false>>;
 
 double carlson_rf(double x, double y, double z) { return boost::math::ellint_rf(x, y, z, CarlsonPolicy()); }
-double carlson_rj(double x, double y, double z, double p) {
-  return boost::math::ellint_rj(x, y, z, p, CarlsonPolicy());
+
+// R_J(x, y, 1, p) for the precession integral on the hot path, where x = cn^2, y = dn^2 <= 1 <= p.
+// Carlson's duplication algorithm (Carlson 1995; DLMF 19.36.ii), the same method as Boost's
+// ellint_rj, specialised to these arguments: p >= x, y, z makes every E_m >= 0, so each
+// R_C(1, 1 + E_m) is atan(sqrt E)/sqrt E, and once E_m is small (it falls ~64x per step) its series
+// replaces the atan. Compared against Boost over this argument range to a few ulps.
+double carlson_rj_precession(double x, double y, double p) {
+  double z = 1.0;
+  const double A0 = (x + y + z + 2.0 * p) / 5.0;
+  // Duplication stops once 4^-m Q < A_m, Q = (eps/5)^(-1/8) max|A0 - arg|: the 5th-order series is
+  // then exact to rounding (Boost's criterion, eps = 2^-52).
+  constexpr double kStop = 110.7;  // (2^-52 / 5)^(-1/8) = 110.68
+  const double Q = kStop * std::max({std::abs(A0 - x), std::abs(A0 - y), std::abs(A0 - z), std::abs(A0 - p)});
+  double A = A0, delta = (p - x) * (p - y) * (p - z), scale = 1.0, rc_sum = 0.0;
+  const double x0 = x, y0 = y, z0 = z;
+  for (int iteration = 0; iteration < 64; ++iteration) {
+    const double rx = std::sqrt(x), ry = std::sqrt(y), rz = std::sqrt(z), rp = std::sqrt(p);
+    const double D = (rp + rx) * (rp + ry) * (rp + rz);
+    const double E = delta / (D * D);
+    // R_C(1, 1 + E) = atan(sqrt E) / sqrt E = 1 - E/3 + E^2/5 - ...
+    double rc;
+    if (E < 2e-3) {
+      rc = 1.0 + E * (-1.0 / 3 + E * (1.0 / 5 + E * (-1.0 / 7 + E * (1.0 / 9 + E * (-1.0 / 11 + E / 13)))));
+    } else {
+      const double rE = std::sqrt(E);
+      rc = std::atan(rE) / rE;
+    }
+    rc_sum += scale / D * rc;
+    const double lambda = rx * ry + rx * rz + ry * rz;
+    A = (A + lambda) / 4.0;
+    scale /= 4.0;
+    if (scale * Q < A) break;
+    x = (x + lambda) / 4.0;
+    y = (y + lambda) / 4.0;
+    z = (z + lambda) / 4.0;
+    p = (p + lambda) / 4.0;
+    delta /= 64.0;
+  }
+  const double X = scale * (A0 - x0) / A, Y = scale * (A0 - y0) / A, Z = scale * (A0 - z0) / A;
+  const double P = -(X + Y + Z) / 2.0;
+  const double E2 = X * Y + X * Z + Y * Z - 3.0 * P * P;
+  const double E3 = X * Y * Z + 2.0 * E2 * P + 4.0 * P * P * P;
+  const double E4 = (2.0 * X * Y * Z + E2 * P + 3.0 * P * P * P) * P;
+  const double E5 = X * Y * Z * P * P;
+  const double series = 1.0 - 3.0 * E2 / 14.0 + E3 / 6.0 + 9.0 * E2 * E2 / 88.0 - 3.0 * E4 / 22.0 -
+                        9.0 * E2 * E3 / 52.0 + 3.0 * E5 / 26.0 - E2 * E2 * E2 / 16.0 + 3.0 * E3 * E3 / 40.0 +
+                        3.0 * E2 * E4 / 20.0 + 45.0 * E2 * E2 * E3 / 272.0 - 9.0 * (E3 * E4 + E2 * E5) / 68.0;
+  return scale / (A * std::sqrt(A)) * series + 6.0 * rc_sum;
 }
 
 constexpr double kSymmetricTolerance = 1e-12;
@@ -77,7 +129,7 @@ bool is_symmetric_top(const Vec3& moments) {
 
 TorqueFreeRotation::TorqueFreeRotation(const Vec3& moments, const Mat3& R0, const Vec3& L_world)
     : I_(moments), R0_(R0), L_(L_world) {
-  if (L_.x() == 0.0 && L_.y() == 0.0 && L_.z() == 0.0) {
+  if (L_.squaredNorm() == 0.0) {  // zero, or so small that |L|^2 underflows (omega ~ 0 anyway)
     kind_ = Kind::Still;
     return;
   }
@@ -217,7 +269,7 @@ void TorqueFreeRotation::init_general(const Vec3& L_body) {
     g.two_K = kPi / scale;  // sn(u) = sin(u * scale) at the bottom, so am(K) = pi/2 there
     g.inv_two_K = scale / kPi;
     // Precession integral over a half period: f(K) = (n'/3) R_J(0, k'^2, 1, 1 + n').
-    g.two_fK = 2.0 * g.n_prime / 3.0 * carlson_rj(0.0, g.kc2, 1.0, 1.0 + g.n_prime);
+    g.two_fK = 2.0 * g.n_prime / 3.0 * carlson_rj_precession(0.0, g.kc2, 1.0 + g.n_prime);
     // Initial amplitude: (sn u0, cn u0) is the direction of (L_m0 / q, L_c0) (P > 0), defined
     // even when P = 0; then u0 = F(am u0 | k) by Carlson's form sn R_F(cn^2, dn^2, 1).
     double sn0 = Lm0 / g.q_ratio, cn0 = Lc0;
@@ -233,13 +285,12 @@ void TorqueFreeRotation::init_general(const Vec3& L_body) {
     // |am| > pi/2: F(am) = 2K - F(pi - am) (mod 4K, the period of sn and cn).
     g.u0 = cn0 >= 0.0 ? F_reduced : g.two_K - F_reduced;
   }
-  g.f0 = 0.0;
   const JacobiState start = jacobi_state(0.0);
   g.f0 = start.f;
 
-  // F = R0 B(0)^T: general_orientation(0) then returns R0 B(0)^T B(0) = R0.
+  // F = R0 B(0)^T: general_orientation at t = 0 then returns R0 B(0)^T B(0) = R0.
   g.frame = Mat3::Identity();
-  const Mat3 B0 = general_orientation(0.0, nullptr);  // = B(0) while frame is the identity
+  const Mat3 B0 = general_orientation(start, 0.0, nullptr);  // = B(0) while frame is the identity
   g.frame = R0_ * B0.transpose();
 
   // Bounds. Along the orbit s = sn^2 runs over [0, 1] and L_c^2 = P^2 (1 - s), L_m^2 = Q^2 s,
@@ -298,8 +349,8 @@ TorqueFreeRotation::JacobiState TorqueFreeRotation::jacobi_state(double t) const
     dn = dn_up;
   }
   const double sn2 = sn * sn;
-  const double f_r = g.n_prime / 3.0 * sn2 * sn * carlson_rj(cn * cn, dn * dn, 1.0, 1.0 + g.n_prime * sn2);
-  const bool odd = std::fmod(half_periods, 2.0) != 0.0;
+  const double f_r = g.n_prime / 3.0 * sn2 * sn * carlson_rj_precession(cn * cn, dn * dn, 1.0 + g.n_prime * sn2);
+  const bool odd = half_periods != 2.0 * std::floor(0.5 * half_periods);
   js.sn = odd ? -sn : sn;
   js.cn = odd ? -cn : cn;
   js.dn = dn;
@@ -321,9 +372,8 @@ Mat3 TorqueFreeRotation::symmetric_orientation(double t) const {
   return R;
 }
 
-Mat3 TorqueFreeRotation::general_orientation(double t, Vec3* L_body) const {
+Mat3 TorqueFreeRotation::general_orientation(const JacobiState& js, double t, Vec3* L_body) const {
   const General& g = gen_;
-  const JacobiState js = jacobi_state(t);
   const double Lc = g.P * js.cn, Lm = g.Q * js.sn, Ld = g.D * js.dn;
   // Direction of (L_c, L_m) in the plane normal to e_d: sign(P) (cn, q sn), defined even when P = 0
   // (L_b on the d axis), where psi is the limit of nearby orbits and keeps phi + psi right.
@@ -365,7 +415,7 @@ Mat3 TorqueFreeRotation::orientation(double t) const {
     case Kind::General:
       break;
   }
-  return gen_.steady ? symmetric_orientation(t) : general_orientation(t, nullptr);
+  return gen_.steady ? symmetric_orientation(t) : general_orientation(jacobi_state(t), t, nullptr);
 }
 
 void TorqueFreeRotation::state(double t, Mat3& R, Vec3& omega_world) const {
@@ -381,7 +431,7 @@ void TorqueFreeRotation::state(double t, Mat3& R, Vec3& omega_world) const {
     return;
   }
   Vec3 L_body;
-  R = general_orientation(t, &L_body);
+  R = general_orientation(jacobi_state(t), t, &L_body);
   omega_world = R * L_body.cwiseProduct(gen_.inv_I);
 }
 

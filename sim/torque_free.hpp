@@ -2,7 +2,7 @@
 // World angular momentum L is constant; the body frame here is the principal frame
 // (inertia diagonal, moments I1 <= I2 <= I3). Symmetric tops use regular precession;
 // the general case uses Jacobi elliptic functions and the elliptic integral of the
-// third kind (Carlson form, Boost.Math) for the precession angle, so energy and |L| are conserved to
+// third kind (Carlson form) for the precession angle, so energy and |L| are conserved to
 // rounding at any spin and any flight time.
 #pragma once
 
@@ -52,7 +52,7 @@ class TorqueFreeRotation {
   // Asymmetric top: Jacobi's solution (Landau-Lifshitz §37), see torque_free.cpp for the formulas.
   // Body axes: d = the axis L_b circles (never crosses zero), m = the middle moment, c = the
   // other one; L_c = P cn(u), L_m = Q sn(u), L_d = D dn(u) with u = lambda t + u0.
-  static constexpr int kMaxLandenLevels = 24;
+  static constexpr int kMaxLandenLevels = 16;  // 12 suffice down to k'^2 = 5e-324
   struct General {
     bool steady = false;      // L along a principal axis exactly: evaluated through sym_
     bool separatrix = false;  // k == 1 exactly: sn = tanh, cn = dn = sech, no period
@@ -85,7 +85,7 @@ class TorqueFreeRotation {
   void init_general(const Vec3& L_body);
   JacobiState jacobi_state(double t) const;
   Mat3 symmetric_orientation(double t) const;
-  Mat3 general_orientation(double t, Vec3* L_body) const;
+  Mat3 general_orientation(const JacobiState& js, double t, Vec3* L_body) const;
 };
 
 // True when two principal moments agree within a relative 1e-12 (closed-form symmetric top).
