@@ -1,5 +1,6 @@
 #include <cstdio>
 #include <exception>
+#include <string_view>
 
 #include "apps/commands.hpp"
 #include "sim/scene_error.hpp"
@@ -12,7 +13,7 @@ void SceneArgs::add_to(CLI::App* cmd) {
                   "Override a scene key, KEY=VALUE in TOML syntax; repeatable.\n"
                   "e.g. --set materials.steel.restitution=1.0 --set throw.spin.sd=30")
       ->type_name("KEY=VALUE");
-  cmd->add_option("--fidelity", fidelity, "Physical model (the scene's sim.fidelity otherwise): paper")
+  cmd->add_option("--fidelity", fidelity, "Physical model (the scene's sim.fidelity otherwise): static, paper, impulse, stepped, auto")
       ->type_name("F");
 }
 
@@ -23,6 +24,9 @@ SceneDef SceneArgs::load() const {
 }
 
 int run_cli(int argc, char** argv) {
+  // `dicesim bench tradeoff SCENE` lives next to `dicesim bench SCENE` (whose SCENE is positional).
+  if (argc >= 3 && std::string_view(argv[1]) == "bench" && std::string_view(argv[2]) == "tradeoff")
+    return run_bench_tradeoff(argc - 2, argv + 2);
   CLI::App app{
       "dicesim: how likely is each face of a real, possibly unfair die?\n"
       "Simulates physical tosses (flight, bounces, rest) of a die of any density layout.\n\n"
@@ -36,6 +40,14 @@ int run_cli(int argc, char** argv) {
   register_toss(app, exit_code);
   register_info(app, exit_code);
   register_bench(app, exit_code);
+  app.get_subcommand("bench")->footer(
+      "\nSpeed against accuracy of the fidelity ladder:  dicesim bench tradeoff SCENE --help");
+  register_sweep(app, exit_code);
+  register_calibrate(app, exit_code);
+  register_compare(app, exit_code);
+  register_worker(app, exit_code);
+  register_aggregate(app, exit_code);
+  register_run(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -12,6 +12,15 @@ namespace {
 nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 nlohmann::json mat(const Mat3& m) { return {vec(m.row(0)), vec(m.row(1)), vec(m.row(2))}; }
 
+// Resting geometry: per face, the COM height on it and the lowest pass over its edges.
+nlohmann::json rest_json(const DieModel& m) {
+  nlohmann::json faces = nlohmann::json::array();
+  for (int f = 0; f < 6; ++f)
+    faces.push_back({{"label", m.face_labels[f]}, {"height", m.face_height[f]}, {"escape_height", m.face_escape[f]},
+                     {"tip_ratio", m.face_tip_ratio[f]}});
+  return faces;
+}
+
 nlohmann::json info_json(const std::string& path, const DieModel& m) {
   const MassProperties& mp = m.mass_geometric;
   nlohmann::json faces = nlohmann::json::array();
@@ -36,7 +45,10 @@ nlohmann::json info_json(const std::string& path, const DieModel& m) {
           {"bounding_radius", m.bounding_radius},
           {"faces", faces},
           {"corners", corners},
-          {"fidelity", to_string(m.fidelity)}};
+          {"fidelity", to_string(m.fidelity)},
+          {"fidelity_requested", to_string(m.fidelity_requested)},
+          {"fidelity_reason", m.fidelity_reason},
+          {"rest", rest_json(m)}};
 }
 
 void print_info(const std::string& path, const DieModel& m) {
@@ -59,7 +71,12 @@ void print_info(const std::string& path, const DieModel& m) {
   for (int c = 0; c < 8; ++c)
     std::printf("  (%c,%c,%c)  e = %.4f  mu = %.3f\n", (c & 1) ? '+' : '-', (c & 2) ? '+' : '-', (c & 4) ? '+' : '-',
                 m.vertex_restitution[c], m.vertex_friction[c]);
-  std::printf("\nfidelity           %s\n", to_string(m.fidelity));
+  std::printf("\nresting (COM height on the face; lowest COM height over its edges)\n");
+  for (int f = 0; f < 6; ++f)
+    std::printf("  %d: %.6g m, escape %.6g m\n", m.face_labels[f], m.face_height[f], m.face_escape[f]);
+  std::printf("\nfidelity           %s", to_string(m.fidelity));
+  if (m.fidelity_requested == Fidelity::Auto) std::printf(" (chosen by auto)");
+  std::printf("\n  why              %s\n", m.fidelity_reason.c_str());
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <thread>
 
+#include "aggregator/target.hpp"
 #include "apps/commands.hpp"
 #include "apps/progress.hpp"
 #include "apps/report.hpp"
@@ -18,7 +19,25 @@ struct TossArgs {
   std::uint64_t seed = 1;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   bool json = false;
+  double target_halfwidth = 0.0;
+  CLI::Option* tosses_opt = nullptr;
 };
+
+// --target-halfwidth: blocks of agg::kTargetBlock in index order, stopping at the first block
+// boundary where every face's half-width is <= H; the stopping point is independent of threads.
+RunCounts run_to_target(const DieModel& model, RunConfig cfg, std::uint64_t cap, double h, std::uint64_t& done) {
+  RunCounts total;
+  const auto progress = cfg.progress;
+  for (done = 0; done < cap && !agg::halfwidth_reached(total, h);) {
+    cfg.first = done;
+    cfg.tosses = std::min(agg::kTargetBlock, cap - done);
+    const std::uint64_t base = done;
+    cfg.progress = [&](std::uint64_t d, std::uint64_t) { progress(base + d, cap); };
+    total.merge(run_tosses(model, cfg));
+    done += cfg.tosses;
+  }
+  return total;
+}
 
 int run_toss(const TossArgs& a) {
   const SceneDef def = a.scene.load();
@@ -32,16 +51,24 @@ int run_toss(const TossArgs& a) {
   cfg.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
 
   const auto t0 = std::chrono::steady_clock::now();
-  const RunCounts counts = run_tosses(model, cfg);
+  std::uint64_t tosses = a.tosses;
+  const bool target = a.target_halfwidth > 0.0;
+  // With a target and no explicit --tosses, N is only a generous cap.
+  const std::uint64_t cap = target && a.tosses_opt->count() == 0 ? 1'000'000'000ULL : a.tosses;
+  const RunCounts counts = target ? run_to_target(model, cfg, cap, a.target_halfwidth, tosses) : run_tosses(model, cfg);
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   bar.finish();
+  if (target)
+    std::fprintf(stderr, "dicesim: target half-width %g %s after %llu tosses (widest: %.5f)\n", a.target_halfwidth,
+                 agg::halfwidth_reached(counts, a.target_halfwidth) ? "reached" : "NOT reached",
+                 static_cast<unsigned long long>(tosses), agg::max_halfwidth(counts));
 
   RunReport r;
   r.scene = a.scene.path;
   r.fidelity = to_string(model.fidelity);
   r.seed = a.seed;
   r.threads = a.threads;
-  r.tosses = a.tosses;
+  r.tosses = tosses;
   r.counts = counts;
   r.labels = model.face_labels;
   r.elapsed_s = elapsed;
@@ -64,14 +91,22 @@ void register_toss(CLI::App& app, int& exit_code) {
       "Examples:\n"
       "  dicesim toss scenes/paper/die1.toml\n"
       "  dicesim toss scenes/paper/die1.toml --tosses 1000000 --threads 2 --json\n"
-      "  dicesim toss scenes/fair.toml --set throw.height.mean=0.5 --set sim.stop_speed=0.01");
+      "  dicesim toss scenes/fair.toml --set throw.height.mean=0.5 --set sim.stop_speed=0.01\n"
+      "  dicesim toss scenes/paper/die3.toml --target-halfwidth 0.002   # as many tosses as that takes");
   args->scene.add_to(cmd);
-  cmd->add_option("-n,--tosses", args->tosses, "Number of tosses")->capture_default_str()->check(CLI::Range(1ULL, 1ULL << 40));
+  args->tosses_opt = cmd->add_option("-n,--tosses", args->tosses, "Number of tosses (with --target-halfwidth: the most it may take)")
+                         ->capture_default_str()
+                         ->check(CLI::Range(1ULL, 1ULL << 40));
   cmd->add_option("--seed", args->seed, "Run seed (with the toss index, the only source of randomness)")
       ->capture_default_str();
   cmd->add_option("-j,--threads", args->threads, "Worker threads (default: all cores)")
       ->capture_default_str()
       ->check(CLI::Range(1, 1024));
+  cmd->add_option("--target-halfwidth", args->target_halfwidth,
+                  "Stop when every face's 95% half-width is <= H, judged every 10000 tosses in index order\n"
+                  "(deterministic: the same stopping point on any number of threads or workers)")
+      ->type_name("H")
+      ->check(CLI::Range(1e-6, 0.5));
   cmd->add_flag("--json", args->json, "Print exactly one JSON object on stdout instead of the table");
   cmd->callback([args, &exit_code] { exit_code = run_toss(*args); });
 }

@@ -2,6 +2,9 @@
 // exit code: 0 ok, 1 failed, 2 bad input.
 #pragma once
 
+#include <atomic>
+#include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,6 +28,32 @@ struct SceneArgs {
 void register_toss(CLI::App& app, int& exit_code);
 void register_info(CLI::App& app, int& exit_code);
 void register_bench(CLI::App& app, int& exit_code);
+// `dicesim bench tradeoff SCENE ...` (cmd_tradeoff.cpp): argv[0] is "tradeoff".
+int run_bench_tradeoff(int argc, char** argv);
+void register_sweep(CLI::App& app, int& exit_code);      // cmd_sweep.cpp
+void register_calibrate(CLI::App& app, int& exit_code);  // cmd_calibrate.cpp
+void register_compare(CLI::App& app, int& exit_code);    // cmd_compare.cpp
+void register_worker(CLI::App& app, int& exit_code);
+void register_aggregate(CLI::App& app, int& exit_code);
+void register_run(CLI::App& app, int& exit_code);
+
+// Distributed runs (cmd_aggregate.cpp): what `aggregate` and `run` share.
+struct AggregateArgs {
+  SceneArgs scene;
+  std::string lcm;
+  std::uint64_t tosses = 100000;
+  CLI::Option* tosses_opt = nullptr;  // given explicitly? (with a target it is only a cap)
+  std::uint64_t seed = 1;
+  int trace_every = 0;
+  double target_halfwidth = 0.0;
+  double timeout_s = 0.0;
+  bool json = false;
+  void add_to(CLI::App* cmd);
+};
+// Starts the run on `url`, aggregates it to the end and prints the report as `toss` does.
+// `workers` (> 0) is reported as the thread count; `on_tick` may return an error to abort.
+int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::int64_t run_id, int workers,
+                         const std::function<std::string()>& on_tick, const std::atomic<bool>* cancel);
 
 // Runs the command line; returns the process exit code. main() only calls this.
 int run_cli(int argc, char** argv);

@@ -21,8 +21,10 @@ class ProgressBar {
     std::lock_guard lock(mu_);
     const double t = seconds();
     if (t < 1.0) return;
+    if (done == last_done_) return;  // nothing new (the final count is reported twice)
     if (!tty_ && t - last_line_ < 10.0 && done < total) return;
     last_line_ = t;
+    last_done_ = done;
     const double frac = static_cast<double>(done) / static_cast<double>(total);
     const double rate = static_cast<double>(done) / t;
     const double eta = rate > 0 ? static_cast<double>(total - done) / rate : 0.0;
@@ -51,6 +53,7 @@ class ProgressBar {
   bool enabled_, tty_;
   bool drawn_ = false;
   double last_line_ = 0.0;
+  std::uint64_t last_done_ = ~std::uint64_t{0};
   std::mutex mu_;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "sim/fidelity_auto.hpp"
+#include "sim/rest.hpp"
 #include "sim/scene_error.hpp"
 #include "sim/torque_free.hpp"
 
@@ -97,12 +99,17 @@ DieModel compile(const SceneDef& scene, const std::string& origin) {
   }
   m.face_labels = die.face_labels;
 
-  m.fidelity = scene.sim.fidelity;
+  compute_rest_geometry(m);
+  m.max_friction = *std::max_element(m.vertex_friction.begin(), m.vertex_friction.end());
+
   m.gravity = scene.sim.gravity;
+  m.step = scene.sim.step;
+  m.contact_step = scene.sim.contact_step;
   m.stop_speed = scene.sim.stop_speed;
   m.max_bounces = scene.sim.max_bounces;
   m.max_time = scene.sim.max_time;
   m.throw_ = scene.throw_;
+  resolve_fidelity(scene, m);
 
   // The die must start above the floor. With a random orientation any corner may point down, so
   // the mean COM height must clear the bounding sphere; with a fixed one, the lowest corner.

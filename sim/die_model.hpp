@@ -28,8 +28,20 @@ struct DieModel {
   Mat3 geo_to_body = Mat3::Identity();
   bool symmetric_top = false;
 
+  // Resting geometry (sim/rest.hpp), per face in the order above, body frame:
+  std::array<std::array<int, 4>, 6> face_vertices{};  // corners of each face, in cyclic order
+  std::array<double, 6> face_height{};   // COM to the face's plane: the COM height resting on it
+  std::array<double, 6> face_escape{};   // lowest COM height over any edge of the face (tipping barrier)
+  std::array<double, 6> face_tip_ratio{};  // min over edges: (COM projection to edge) / face_height
+  double max_escape = 0.0;               // max of face_escape
+  double max_friction = 0.0;             // max of vertex_friction
+
   // Simulation settings, copied from the scene.
-  Fidelity fidelity = Fidelity::Paper;
+  Fidelity fidelity = Fidelity::Paper;             // the model tosses use (never Auto)
+  Fidelity fidelity_requested = Fidelity::Paper;   // what the scene asked for (may be Auto)
+  std::string fidelity_reason;                     // why `fidelity` (dicesim info prints it)
+  double step = 2e-4;                              // `stepped` time step (s)
+  double contact_step = 1e-3;                      // `impulse` sustained-contact step (s)
   double gravity = 9.81;
   double stop_speed = 0.1;
   int max_bounces = 1000;

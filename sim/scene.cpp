@@ -135,6 +135,7 @@ constexpr Range kAngle{.unit = "deg"};
 constexpr Range kGravity{.lo = 0, .hi = 1000, .lo_open = true, .unit = "m/s^2"};
 constexpr Range kStopSpeed{.lo = 0, .hi = 100, .unit = "m/s"};
 constexpr Range kMaxTime{.lo = 0, .hi = 1e6, .lo_open = true, .unit = "s"};
+constexpr Range kStep{.lo = 1e-7, .hi = 1e-2, .unit = "s"};
 constexpr Range kAnyNumber{};
 
 // Names a key may take, and what each means.
@@ -395,6 +396,8 @@ void read_sim(Reader sim, SimDef& def) {
   def.stop_speed = sim.number("stop_speed", kStopSpeed, def.stop_speed);
   def.max_bounces = sim.integer("max_bounces", 1, 10'000'000, def.max_bounces);
   def.max_time = sim.number("max_time", kMaxTime, def.max_time);
+  def.step = sim.number("step", kStep, def.step);
+  def.contact_step = sim.number("contact_step", kStep, def.contact_step);
   sim.finish();
 }
 

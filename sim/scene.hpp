@@ -93,6 +93,9 @@ struct SimDef {
   double stop_speed = 0.1;      // m/s: `paper` stops when the COM's rebound speed is below this
   int max_bounces = 1000;       // a toss with more impacts is `unresolved`
   double max_time = 60.0;       // s of simulated time; longer is `unresolved`
+  // Accuracy settings of the fidelity ladder (docs/fidelity.md measures what they cost and change).
+  double step = 2e-4;           // s: `stepped`'s fixed time step (the reference)
+  double contact_step = 1e-3;   // s: `impulse`'s time step while the die rolls/slides in sustained contact
 };
 
 struct SceneDef {

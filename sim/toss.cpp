@@ -3,7 +3,12 @@
 #include <chrono>
 #include <cmath>
 
+#include <cstring>
+
+#include <Random123/philox.h>
+
 #include "sim/contact.hpp"
+#include "sim/fidelity_models.hpp"
 #include "sim/outcome.hpp"
 
 namespace dicesim {
@@ -91,19 +96,51 @@ TossResult run_paper(const DieModel& m, RigidState s, TossProbe* probe) {
   }
 }
 
-}  // namespace
+// The toss's tiebreak for exact balances, in [0, 1): Philox keyed by the seed, on a counter word
+// the throw's own draws never use, so the throw is unchanged.
+double tiebreak_of(std::uint64_t seed, std::uint64_t index) {
+  r123::Philox4x32 gen;
+  const r123::Philox4x32::key_type key = {{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32)}};
+  const r123::Philox4x32::ctr_type ctr = {{static_cast<std::uint32_t>(index), static_cast<std::uint32_t>(index >> 32), 0u, 0xD1CEu}};
+  const auto out = gen(ctr, key);
+  return static_cast<double>((static_cast<std::uint64_t>(out.v[0]) << 21) ^ out.v[1]) * 0x1.0p-53;
+}
 
-TossResult toss_from(const DieModel& m, const InitialState& init, TossProbe* probe) {
+// Without a toss index (replays, tests): a hash of the initial state, so still deterministic.
+double tiebreak_of(const InitialState& init) {
+  std::uint64_t h = 0x9E3779B97F4A7C15ull;
+  const double parts[] = {init.com_position.z(), init.velocity.x(), init.velocity.y(), init.velocity.z(),
+                          init.omega.x(), init.omega.y(), init.omega.z(), init.orientation(0, 0), init.orientation(1, 2)};
+  for (double d : parts) {
+    std::uint64_t b;
+    std::memcpy(&b, &d, sizeof b);
+    h = (h ^ b) * 0x100000001B3ull;
+    h ^= h >> 29;
+  }
+  return static_cast<double>(h >> 11) * 0x1.0p-53;
+}
+
+TossResult run(const DieModel& m, const InitialState& init, double tiebreak, TossProbe* probe) {
   const RigidState s = to_body_state(m, init);
   if (!starts_valid(m, s)) return TossResult{};  // status Invalid
   switch (m.fidelity) {
     case Fidelity::Paper: return run_paper(m, s, probe);
+    case Fidelity::Static: return run_static(m, s, tiebreak);
+    case Fidelity::Impulse: return run_impulse(m, s, tiebreak, probe);
+    case Fidelity::Stepped: return run_stepped(m, s, tiebreak, probe);
+    case Fidelity::Auto: break;  // resolved by compile(); never reaches a toss
   }
   return TossResult{};
 }
 
+}  // namespace
+
+TossResult toss_from(const DieModel& m, const InitialState& init, TossProbe* probe) {
+  return run(m, init, tiebreak_of(init), probe);
+}
+
 TossResult toss(const DieModel& m, std::uint64_t seed, std::uint64_t index, TossProbe* probe) {
-  return toss_from(m, draw_initial_state(m.throw_, seed, index), probe);
+  return run(m, draw_initial_state(m.throw_, seed, index), tiebreak_of(seed, index), probe);
 }
 
 }  // namespace dicesim

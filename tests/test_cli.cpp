@@ -18,7 +18,9 @@ struct CliRun {
 };
 
 CliRun dicesim(const std::string& args) {
-  const std::string err_file = ::testing::TempDir() + "dicesim_cli_stderr.txt";
+  // One stderr file per test: CTest runs tests in parallel processes.
+  const std::string err_file = ::testing::TempDir() + "dicesim_cli_stderr_" +
+                               ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".txt";
   const std::string cmd = std::string("cd ") + DICESIM_SOURCE_DIR + " && " + DICESIM_BINARY + " " + args + " 2>" + err_file;
   CliRun r;
   FILE* p = popen(cmd.c_str(), "r");

@@ -1,0 +1,341 @@
+#include "aggregator/aggregator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_set>
+
+#include "aggregator/target.hpp"
+#include "sim/statistics.hpp"
+
+namespace dicesim::agg {
+
+Aggregator::Aggregator(AggregatorConfig cfg, Send send)
+    : cfg_(std::move(cfg)), send_(std::move(send)), limit_(cfg_.spec.total) {
+  for (std::size_t i = 0; i < 6; ++i)
+    if (cfg_.labels[i] >= 1 && cfg_.labels[i] <= 6) label_to_index_[static_cast<std::size_t>(cfg_.labels[i])] =
+        static_cast<std::int8_t>(i + 1);
+}
+
+template <class T>
+void Aggregator::publish(const char* channel, const T& msg) {
+  ++health_.messages_out;
+  send_(channel, wire::encode(msg));
+}
+
+void Aggregator::on_message(std::string_view channel, const void* data, std::size_t len, double now) {
+  ++health_.messages_in;
+  if (channel == wire::kTossBatch) {
+    if (auto b = wire::decode<dicesim_lcm::toss_batch>(data, len)) return on_batch(*b, now);
+    ++health_.malformed;
+  } else if (channel == wire::kWorkerStatus) {
+    if (auto s = wire::decode<dicesim_lcm::worker_status>(data, len)) return on_status(*s, now);
+    ++health_.malformed;
+  } else if (channel == wire::kRunStart) {
+    // Another aggregator's run on the same URL is foreign; our own echo is not counted.
+    auto r = wire::decode<dicesim_lcm::run_start>(data, len);
+    if (!r) ++health_.malformed;
+    else if (r->run_id != cfg_.spec.run_id) ++health_.foreign;
+  } else if (channel == wire::kWorkLease || channel == wire::kProbabilities || channel == wire::kBounceState) {
+    // Our own messages come back (multicast loops back); only check that they decode.
+    bool ok = false;
+    std::int64_t run = 0;
+    if (channel == wire::kWorkLease) {
+      if (auto m = wire::decode<dicesim_lcm::work_lease>(data, len)) ok = true, run = m->run_id;
+    } else if (channel == wire::kProbabilities) {
+      if (auto m = wire::decode<dicesim_lcm::probabilities>(data, len)) ok = true, run = m->run_id;
+    } else if (auto m = wire::decode<dicesim_lcm::bounce_state>(data, len)) {
+      ok = true, run = m->run_id;
+    }
+    if (!ok) ++health_.malformed;
+    else if (run != cfg_.spec.run_id) ++health_.foreign;
+  }
+}
+
+bool Aggregator::valid_batch(const dicesim_lcm::toss_batch& b) const {
+  const std::size_t n = static_cast<std::size_t>(b.count);
+  if (b.count < 1 || b.faces.size() != n || b.statuses.size() != n || b.bounces.size() != n) return false;
+  for (std::size_t k = 0; k < n; ++k) {
+    const int face = b.faces[k], status = b.statuses[k];
+    if (b.bounces[k] < 0) return false;
+    if (status == 0) {
+      if (face < 1 || face > 6 || label_to_index_[static_cast<std::size_t>(face)] == 0) return false;
+    } else if ((status != 1 && status != 2) || face != 0) {
+      return false;
+    }
+  }
+  return true;
+}
+
+void Aggregator::on_batch(const dicesim_lcm::toss_batch& b, double now) {
+  if (b.run_id != cfg_.spec.run_id) {
+    ++health_.foreign;
+    return;
+  }
+  if (b.first_index < 0 || b.count < 1 || static_cast<std::uint64_t>(b.first_index) >= cfg_.spec.total ||
+      static_cast<std::uint64_t>(b.count) > cfg_.spec.total - static_cast<std::uint64_t>(b.first_index)) {
+    ++health_.range;
+    return;
+  }
+  if (!valid_batch(b)) {
+    ++health_.malformed;
+    return;
+  }
+  ++health_.batches;
+  if (auto w = workers_.find(b.worker_id); w != workers_.end()) w->second.last_seen = now;
+  const std::uint64_t first = static_cast<std::uint64_t>(b.first_index), n = static_cast<std::uint64_t>(b.count);
+  const std::uint64_t fresh = received_.add(first, first + n, [&](std::uint64_t lo, std::uint64_t hi) {
+    ingest(first, lo, hi, b);
+  });
+  health_.duplicates += n - fresh;
+  if (finished_) return;
+  advance_prefix();
+  if (finished_) return finish(now);
+  // A completed lease frees its worker's slot at once: the next lease is on its way before the
+  // worker runs out of queued work.
+  if (auto it = leases_.find(b.lease_id); it != leases_.end() && it->second.worker == b.worker_id &&
+                                           received_.covers(it->second.first, it->second.first + it->second.count)) {
+    leases_.erase(it);
+    grant(b.worker_id, now);
+  }
+}
+
+void Aggregator::ingest(std::uint64_t first, std::uint64_t lo, std::uint64_t hi, const dicesim_lcm::toss_batch& b) {
+  // Split at block boundaries; each piece is summed locally, then added to its block.
+  while (lo < hi) {
+    const std::uint64_t block = lo / kTargetBlock;
+    const std::uint64_t end = std::min(hi, (block + 1) * kTargetBlock);
+    RunCounts c;
+    for (std::uint64_t i = lo; i < end; ++i) {
+      const std::size_t k = static_cast<std::size_t>(i - first);
+      switch (b.statuses[k]) {
+        case 0:
+          ++c.settled;
+          ++c.faces[static_cast<std::size_t>(label_to_index_[static_cast<std::size_t>(b.faces[k])] - 1)];
+          break;
+        case 1: ++c.unresolved; break;
+        default: ++c.invalid; break;
+      }
+      c.bounces += static_cast<std::uint64_t>(b.bounces[k]);
+    }
+    blocks_[block].merge(c);
+    all_.merge(c);
+    lo = end;
+  }
+}
+
+void Aggregator::advance_prefix() {
+  while (prefix_end_ < limit_) {
+    const std::uint64_t block = prefix_end_ / kTargetBlock;
+    const std::uint64_t end = std::min(limit_, (block + 1) * kTargetBlock);
+    if (!received_.covers(prefix_end_, end)) return;
+    if (auto it = blocks_.find(block); it != blocks_.end()) {
+      prefix_.merge(it->second);
+      blocks_.erase(it);
+    }
+    prefix_end_ = end;
+    if (cfg_.target_halfwidth > 0.0 && halfwidth_reached(prefix_, cfg_.target_halfwidth)) limit_ = prefix_end_;
+  }
+  finished_ = true;
+}
+
+void Aggregator::finish(double now) {
+  finished_ = true;
+  leases_.clear();
+  // Three copies: a worker that misses all of them still stops when run_start stops.
+  for (int i = 0; i < 3; ++i) publish_probabilities(now);
+}
+
+void Aggregator::on_status(const dicesim_lcm::worker_status& s, double now) {
+  if (s.run_id != 0 && s.run_id != cfg_.spec.run_id) {
+    ++health_.foreign;
+    return;
+  }
+  if (s.state < 0 || s.state > 2 || s.n_held > 64 || s.last_done_lease < 0) {
+    ++health_.malformed;
+    return;
+  }
+  if (finished_) return;
+  Worker& w = workers_[s.worker_id];
+  w.last_seen = now;
+  w.rate = std::isfinite(s.tosses_per_s) && s.tosses_per_s > 0 ? s.tosses_per_s : 0.0;
+  if (s.run_id == 0 || s.state == 0) {  // has not got (or not yet compiled) our run: tell it again
+    w.ready = false;
+    if (now - last_run_start_ > 0.2) publish_run_start(), last_run_start_ = now;
+    return;
+  }
+  if (s.state == 2) {
+    w.ready = false;
+    if (!refused_[s.worker_id]) {
+      refused_[s.worker_id] = true;
+      refusals_.push_back("worker " + std::to_string(s.worker_id) + " (" + s.host + ", pid " + std::to_string(s.pid) +
+                          ") refused the run: " + s.error);
+    }
+    return;
+  }
+  w.ready = true;
+  const std::unordered_set<std::int64_t> held(s.held_leases.begin(), s.held_leases.end());
+  for (auto it = leases_.begin(); it != leases_.end();) {
+    Lease& l = it->second;
+    if (l.worker != s.worker_id || held.count(l.id)) {
+      ++it;
+    } else if (l.id <= s.last_done_lease) {
+      if (l.done_at < 0) l.done_at = now;  // finished; its last batch may still be on the way
+      ++it;
+    } else if (now - l.granted > cfg_.lost_lease_s) {
+      release(l);  // the worker never received it
+      it = leases_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  grant(s.worker_id, now);
+}
+
+void Aggregator::release(const Lease& l) {
+  const std::uint64_t hi = std::min(limit_, l.first + l.count);
+  for (const IntervalSet::Range& g : received_.gaps(l.first, hi)) health_.released += requeue_.add(g.first, g.second);
+}
+
+void Aggregator::grant(std::int64_t worker, double now) {
+  if (finished_) return;
+  auto wit = workers_.find(worker);
+  if (wit == workers_.end() || !wit->second.ready) return;
+  int held = 0;
+  std::uint64_t queued = 0;
+  for (const auto& [id, l] : leases_)
+    if (l.worker == worker && l.done_at < 0) ++held, queued += l.count;
+  while (held < cfg_.leases_per_worker) {
+    std::uint64_t a = 0, b = 0;
+    // Holes first (lowest indices: they hold back the result), then fresh indices.
+    while (!requeue_.empty() && b == 0) {
+      auto [lo, hi] = requeue_.first();
+      if (lo >= limit_) {
+        requeue_.remove(lo, ~0ULL);
+        break;
+      }
+      hi = std::min({hi, limit_, lo + cfg_.max_lease});
+      requeue_.remove(lo, hi);
+      const auto g = received_.gaps(lo, hi);
+      if (g.empty()) continue;
+      a = g[0].first, b = g[0].second;
+      for (std::size_t i = 1; i < g.size(); ++i) requeue_.add(g[i].first, g[i].second);
+    }
+    if (b == 0 && frontier_ < limit_) {
+      // Leases shrink towards the end so that every worker finishes at about the same time.
+      const std::uint64_t remaining = limit_ - frontier_;
+      const std::uint64_t live = static_cast<std::uint64_t>(std::max(1, live_workers()));
+      const std::uint64_t size =
+          std::min(remaining, std::clamp<std::uint64_t>(remaining / (2 * live), cfg_.min_lease, cfg_.max_lease));
+      a = frontier_, b = frontier_ + size;
+      frontier_ = b;
+    }
+    if (b == 0) return;
+    Lease l;
+    l.id = next_lease_++;
+    l.worker = worker;
+    l.first = a;
+    l.count = b - a;
+    l.granted = now;
+    queued += l.count;
+    const double rate = std::max(wit->second.rate, 500.0);
+    l.deadline = now + 3.0 * static_cast<double>(queued) / rate + 2.0 * cfg_.worker_timeout_s;
+    leases_[l.id] = l;
+    ++held;
+    ++health_.leases;
+    dicesim_lcm::work_lease m;
+    m.utime = wire::now_utime();
+    m.run_id = cfg_.spec.run_id;
+    m.worker_id = worker;
+    m.lease_id = l.id;
+    m.first_index = static_cast<std::int64_t>(l.first);
+    m.count = static_cast<std::int64_t>(l.count);
+    m.deadline_utime = m.utime + static_cast<std::int64_t>((l.deadline - now) * 1e6);
+    publish(wire::kWorkLease, m);
+  }
+}
+
+int Aggregator::live_workers() const {
+  int n = 0;
+  for (const auto& [id, w] : workers_) n += w.ready ? 1 : 0;
+  return n;
+}
+
+void Aggregator::tick(double now) {
+  if (started_ < 0) started_ = rate_t_ = now;
+  if (!finished_) {
+    if (now - last_run_start_ >= cfg_.run_start_period_s) publish_run_start(), last_run_start_ = now;
+    for (auto it = workers_.begin(); it != workers_.end();) {
+      if (now - it->second.last_seen <= cfg_.worker_timeout_s) {
+        ++it;
+        continue;
+      }
+      for (auto l = leases_.begin(); l != leases_.end();) {
+        if (l->second.worker == it->first) release(l->second), l = leases_.erase(l);
+        else ++l;
+      }
+      it = workers_.erase(it);
+    }
+    for (auto it = leases_.begin(); it != leases_.end();) {
+      const Lease& l = it->second;
+      if (received_.covers(l.first, std::min(limit_, l.first + l.count))) {
+        it = leases_.erase(it);
+      } else if ((l.done_at >= 0 && now - l.done_at > cfg_.done_grace_s) || now > l.deadline) {
+        release(l);
+        it = leases_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    for (const auto& [id, w] : workers_)
+      if (w.ready) grant(id, now);
+  }
+  if (now - last_probabilities_ >= cfg_.probabilities_period_s) publish_probabilities(now);
+}
+
+void Aggregator::publish_run_start() { publish(wire::kRunStart, wire::to_message(cfg_.spec)); }
+
+dicesim_lcm::probabilities Aggregator::snapshot() const {
+  const RunCounts& c = finished_ ? prefix_ : all_;
+  dicesim_lcm::probabilities m;
+  m.utime = wire::now_utime();
+  m.run_id = cfg_.spec.run_id;
+  // Faces in label order, as the printed table.
+  std::array<std::size_t, 6> order{0, 1, 2, 3, 4, 5};
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cfg_.labels[a] < cfg_.labels[b]; });
+  for (std::size_t r = 0; r < 6; ++r) {
+    const std::size_t i = order[r];
+    m.face_labels[r] = cfg_.labels[i];
+    m.counts[r] = static_cast<std::int64_t>(c.faces[i]);
+    m.p[r] = c.settled ? static_cast<double>(c.faces[i]) / static_cast<double>(c.settled) : 0.0;
+    const Interval ci = wilson_interval(c.faces[i], c.settled);
+    m.ci_lo[r] = ci.lo;
+    m.ci_hi[r] = ci.hi;
+  }
+  m.settled = static_cast<std::int64_t>(c.settled);
+  m.unresolved = static_cast<std::int64_t>(c.unresolved);
+  m.invalid = static_cast<std::int64_t>(c.invalid);
+  m.done = static_cast<std::int64_t>(finished_ ? prefix_end_ : received_.size());
+  m.total = static_cast<std::int64_t>(finished_ ? prefix_end_ : cfg_.spec.total);
+  m.tosses_per_s = rate_;
+  m.finished = finished_ ? 1 : 0;
+  m.workers = live_workers();
+  m.duplicates = static_cast<std::int64_t>(health_.duplicates);
+  m.rejected_foreign = static_cast<std::int64_t>(health_.foreign);
+  m.rejected_malformed = static_cast<std::int64_t>(health_.malformed);
+  m.rejected_range = static_cast<std::int64_t>(health_.range);
+  m.released = static_cast<std::int64_t>(health_.released);
+  return m;
+}
+
+void Aggregator::publish_probabilities(double now) {
+  if (now > rate_t_ + 0.5) {  // throughput over the last half second or more
+    const double r = static_cast<double>(received_.size() - rate_n_) / (now - rate_t_);
+    rate_ = rate_ == 0.0 ? r : 0.5 * rate_ + 0.5 * r;
+    rate_t_ = now;
+    rate_n_ = received_.size();
+  }
+  last_probabilities_ = now;
+  publish(wire::kProbabilities, snapshot());
+}
+
+}  // namespace dicesim::agg

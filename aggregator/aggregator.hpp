@@ -1,0 +1,129 @@
+// The aggregator's logic, free of sockets and clocks: bytes in (on_message), messages out (the
+// Send callback), time passed in by the caller. The LCM loop (session.hpp), the unit tests, the
+// fuzzer and the ingest benchmark all drive this one class.
+//
+// Correctness rests on the toss index: results are kept in an interval set, so a repeated index
+// is a duplicate (counted, ignored) and a missing one is a gap that is leased again until it
+// arrives. Counts are kept per block of kTargetBlock indices so that the result over [0, stop)
+// is exact even when later tosses arrived first.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "aggregator/interval_set.hpp"
+#include "messages/run_spec.hpp"
+#include "messages/wire.hpp"
+#include "sim/monte_carlo.hpp"
+
+namespace dicesim::agg {
+
+struct AggregatorConfig {
+  wire::RunSpec spec;               // run_id, seed, total, ...: what run_start announces
+  std::array<int, 6> labels{};      // face label per face index (the model's)
+  double target_halfwidth = 0.0;    // > 0: stop at the first block boundary where it holds
+  std::uint64_t max_lease = 8192;   // tosses per lease at most (a few hundred ms of one core)
+  std::uint64_t min_lease = 512;    // ... and at least, except for the last ones
+  int leases_per_worker = 2;        // one in progress, one queued: a worker never waits
+  double worker_timeout_s = 2.0;    // no heartbeat or batch for this long: its leases go elsewhere
+  double lost_lease_s = 0.6;        // a lease the worker does not list after this long was lost
+  double done_grace_s = 0.3;        // after a worker finished a lease, wait this long for stragglers
+  double probabilities_period_s = 0.25;
+  double run_start_period_s = 1.0;
+};
+
+// Why messages were ignored: the aggregator's health, published in `probabilities`.
+struct Health {
+  std::uint64_t batches = 0;     // accepted toss_batch messages
+  std::uint64_t duplicates = 0;  // toss results received again
+  std::uint64_t foreign = 0;     // messages of another run
+  std::uint64_t malformed = 0;   // undecodable, or fields outside their domain
+  std::uint64_t range = 0;       // indices outside [0, total)
+  std::uint64_t released = 0;    // tosses leased again
+  std::uint64_t leases = 0;      // leases granted
+  std::uint64_t messages_out = 0;
+  std::uint64_t messages_in = 0;
+};
+
+class Aggregator {
+ public:
+  using Send = std::function<void(const char* channel, const std::vector<std::uint8_t>& bytes)>;
+  Aggregator(AggregatorConfig cfg, Send send);
+
+  // One received message on `channel`; never throws, whatever the bytes.
+  void on_message(std::string_view channel, const void* data, std::size_t len, double now);
+  // Periodic work: run_start, probabilities, expired leases, dead workers. Call every ~20 ms.
+  void tick(double now);
+
+  bool finished() const { return finished_; }
+  // The answer: counts over toss indices [0, stop()) — all of them, or up to the stopping block.
+  const RunCounts& result() const { return prefix_; }
+  std::uint64_t stop() const { return prefix_end_; }
+  std::uint64_t received() const { return received_.size(); }
+  std::uint64_t total() const { return cfg_.spec.total; }
+  const Health& health() const { return health_; }
+  int live_workers() const;
+  double rate() const { return rate_; }
+  const RunCounts& all_counts() const { return all_; }  // everything received so far
+  // A worker that refused the run (a different build or a scene it cannot load): its message.
+  const std::vector<std::string>& refusals() const { return refusals_; }
+
+  dicesim_lcm::probabilities snapshot() const;
+
+ private:
+  struct Lease {
+    std::int64_t id = 0, worker = 0;
+    std::uint64_t first = 0, count = 0;
+    double granted = 0.0, deadline = 0.0;
+    double done_at = -1.0;  // the worker says it sent every batch
+  };
+  struct Worker {
+    double last_seen = 0.0;
+    double rate = 0.0;
+    bool ready = false;
+  };
+
+  void on_batch(const dicesim_lcm::toss_batch& b, double now);
+  void on_status(const dicesim_lcm::worker_status& s, double now);
+  void ingest(std::uint64_t first, std::uint64_t lo, std::uint64_t hi, const dicesim_lcm::toss_batch& b);
+  bool valid_batch(const dicesim_lcm::toss_batch& b) const;
+  void advance_prefix();
+  void grant(std::int64_t worker, double now);
+  void release(const Lease& l);  // hand the lease's missing indices out again
+  void finish(double now);
+  void publish_run_start();
+  void publish_probabilities(double now);
+  template <class T>
+  void publish(const char* channel, const T& msg);
+
+  AggregatorConfig cfg_;
+  Send send_;
+  std::uint64_t limit_;  // indices [0, limit_) are wanted
+  IntervalSet received_;
+  IntervalSet requeue_;   // to lease again
+  std::uint64_t frontier_ = 0;  // indices >= frontier_ were never leased
+  std::map<std::int64_t, Lease> leases_;
+  std::map<std::int64_t, Worker> workers_;
+  std::int64_t next_lease_ = 1;
+  std::array<std::int8_t, 7> label_to_index_{};  // label 1..6 -> face index + 1 (0: no such label)
+
+  std::map<std::uint64_t, RunCounts> blocks_;  // counts of blocks past the prefix
+  RunCounts prefix_;                           // counts of [0, prefix_end_)
+  std::uint64_t prefix_end_ = 0;
+  RunCounts all_;
+
+  Health health_;
+  std::vector<std::string> refusals_;
+  std::map<std::int64_t, bool> refused_;
+  bool finished_ = false;
+  double last_probabilities_ = -1e9, last_run_start_ = -1e9, started_ = -1.0;
+  double rate_ = 0.0, rate_t_ = 0.0;
+  std::uint64_t rate_n_ = 0;
+};
+
+}  // namespace dicesim::agg

@@ -1,0 +1,84 @@
+#include "aggregator/session.hpp"
+
+#include <chrono>
+#include <memory>
+
+#include <lcm/lcm-cpp.hpp>
+
+namespace dicesim::agg {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Forwards every subscribed channel's raw bytes to the Aggregator.
+struct Inbox {
+  Aggregator* agg;
+  std::chrono::steady_clock::time_point t0;
+  void handle(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    agg->on_message(channel, rbuf->data, rbuf->data_size, seconds_since(t0));
+  }
+};
+
+}  // namespace
+
+std::string health_line(const Health& h) {
+  return "batches " + std::to_string(h.batches) + ", duplicates " + std::to_string(h.duplicates) +
+         ", rejected: foreign " + std::to_string(h.foreign) + ", malformed " + std::to_string(h.malformed) +
+         ", out of range " + std::to_string(h.range) + "; re-leased " + std::to_string(h.released) +
+         " tosses; messages in " + std::to_string(h.messages_in) + ", out " + std::to_string(h.messages_out);
+}
+
+SessionResult run_session(const SessionOptions& opt, const AggregatorConfig& cfg) {
+  SessionResult res;
+  lcm::LCM bus(opt.url);
+  if (!bus.good()) {
+    res.error = "cannot open LCM at '" + opt.url + "' (is there a multicast route? see README, Scale-out)";
+    return res;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  Aggregator agg(cfg, [&bus](const char* channel, const std::vector<std::uint8_t>& bytes) {
+    bus.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+  });
+  Inbox inbox{&agg, t0};
+  for (const char* ch : {wire::kTossBatch, wire::kWorkerStatus, wire::kRunStart, wire::kWorkLease,
+                         wire::kProbabilities, wire::kBounceState}) {
+    // Bounce states are for other subscribers; listening keeps their malformed copies counted,
+    // but a small queue is enough (excess is dropped by LCM, never by us silently elsewhere).
+    lcm::Subscription* sub = bus.subscribe(ch, &Inbox::handle, &inbox);
+    sub->setQueueCapacity(ch == wire::kBounceState ? 64 : opt.queue_capacity);
+  }
+
+  double last_tick = -1.0;
+  for (;;) {
+    if (opt.cancel && opt.cancel->load()) {
+      res.end = SessionEnd::Cancelled;
+      break;
+    }
+    bus.handleTimeout(10);
+    const double now = seconds_since(t0);
+    if (now - last_tick >= 0.02) {
+      last_tick = now;
+      agg.tick(now);
+      if (opt.on_tick) {
+        if (std::string why = opt.on_tick(agg); !why.empty()) {
+          res.error = why;
+          break;
+        }
+      }
+    }
+    if (agg.finished()) {
+      res.end = SessionEnd::Finished;
+      break;
+    }
+  }
+  res.elapsed_s = seconds_since(t0);
+  res.counts = agg.result();
+  res.tosses = agg.stop();
+  res.health = agg.health();
+  res.refusals = agg.refusals();
+  return res;
+}
+
+}  // namespace dicesim::agg

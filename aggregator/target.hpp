@@ -1,0 +1,19 @@
+// "Stop when every face's 95% half-width is <= H", made deterministic: tosses are judged in
+// fixed blocks in index order, and a run stops at the first block boundary where the criterion
+// holds. The stopping point depends only on (scene, seed, H), never on threads or workers, so
+// `toss --target-halfwidth` and `run --target-halfwidth` agree to the toss.
+#pragma once
+
+#include <cstdint>
+
+#include "sim/monte_carlo.hpp"
+
+namespace dicesim::agg {
+
+inline constexpr std::uint64_t kTargetBlock = 10000;
+
+// Widest 95% Wilson half-width over the six faces (over settled tosses; 0.5 when none settled).
+double max_halfwidth(const RunCounts& c);
+inline bool halfwidth_reached(const RunCounts& c, double h) { return c.settled > 0 && max_halfwidth(c) <= h; }
+
+}  // namespace dicesim::agg

@@ -1,0 +1,171 @@
+// dicesim aggregate: start a distributed run over LCM, collect it, print it as `toss` does.
+// Also the aggregating half of `dicesim run` (aggregate_and_report).
+#include <algorithm>
+#include <csignal>
+#include <cstdio>
+#include <random>
+
+#include "aggregator/session.hpp"
+#include "aggregator/target.hpp"
+#include "apps/commands.hpp"
+#include "apps/progress.hpp"
+#include "apps/report.hpp"
+#include "messages/run_spec.hpp"
+#include "messages/wire.hpp"
+#include "sim/die_model.hpp"
+
+namespace dicesim {
+namespace {
+
+std::atomic<bool> g_stop{false};
+void on_stop_signal(int) { g_stop = true; }
+
+// With a target and no explicit --tosses, the run may go this far.
+constexpr std::uint64_t kTargetCap = 1'000'000'000;
+
+std::int64_t new_run_id() {
+  std::random_device rd;
+  std::uint64_t v = 0;
+  while (v == 0) v = ((std::uint64_t{rd()} << 32) ^ rd()) & INT64_MAX;
+  return static_cast<std::int64_t>(v);
+}
+
+}  // namespace
+
+void AggregateArgs::add_to(CLI::App* cmd) {
+  scene.add_to(cmd);
+  cmd->add_option("--lcm", lcm,
+                  "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0, which never leaves this host)")
+      ->type_name("URL");
+  tosses_opt = cmd->add_option("-n,--tosses", tosses, "Number of tosses (with --target-halfwidth: the most it may take)")
+                   ->capture_default_str()
+                   ->check(CLI::Range(1ULL, 1ULL << 40));
+  cmd->add_option("--seed", seed, "Run seed (with the toss index, the only source of randomness)")->capture_default_str();
+  cmd->add_option("--trace-every", trace_every,
+                  "Publish every impact of every K-th toss on DICESIM_BOUNCE_STATE (0: none)")
+      ->type_name("K")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1 << 30));
+  cmd->add_option("--target-halfwidth", target_halfwidth,
+                  "Stop when every face's 95% half-width is <= H (judged every 10000 tosses, in index order:\n"
+                  "the same stopping point as `dicesim toss --target-halfwidth H`)")
+      ->type_name("H")
+      ->check(CLI::Range(1e-6, 0.5));
+  cmd->add_option("--timeout", timeout_s, "Fail (exit 1) if the run has not finished after this many seconds (0: never)")
+      ->type_name("S")
+      ->check(CLI::Range(0.0, 1e9));
+  cmd->add_flag("--json", json, "Print exactly one JSON object on stdout (the shape of `dicesim toss --json`)");
+}
+
+int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::int64_t run_id, int workers,
+                         const std::function<std::string()>& on_tick, const std::atomic<bool>* cancel) {
+  // Bad input fails here, before anything is published (SceneError -> exit 2 in run_cli).
+  const DieModel model = compile(a.scene.load(), a.scene.path);
+  std::vector<std::string> overrides = a.scene.overrides;  // as SceneArgs::load composes them
+  if (!a.scene.fidelity.empty()) overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
+
+  agg::AggregatorConfig cfg;
+  wire::RunSpec& spec = cfg.spec;
+  spec.run_id = run_id != 0 ? run_id : new_run_id();
+  spec.origin = a.scene.path;
+  spec.files = wire::read_scene_files(a.scene.path);
+  spec.overrides = overrides;
+  spec.fidelity = to_string(model.fidelity);
+  spec.seed = a.seed;
+  spec.total = a.target_halfwidth > 0 && a.tosses_opt && a.tosses_opt->count() == 0 ? kTargetCap : a.tosses;
+  spec.trace_every = a.trace_every;
+  spec.fingerprint = wire::model_fingerprint(model);
+  spec.hash = wire::scene_hash(spec.files, overrides);
+  cfg.labels = model.face_labels;
+  cfg.target_halfwidth = a.target_halfwidth;
+  // What a worker will do with run_start, done here first: a run no worker could rebuild fails now.
+  if (wire::model_fingerprint(wire::compile_spec(spec)) != spec.fingerprint) {
+    std::fprintf(stderr, "dicesim: failed: the scene does not rebuild identically from its files (run_start)\n");
+    return kExitFailed;
+  }
+
+  ProgressBar bar;
+  std::size_t refusals_shown = 0;
+  int most_workers = 0;
+  double idle_since = -1.0, last_hint = -1e9;
+  const auto t0 = std::chrono::steady_clock::now();
+  agg::SessionOptions opt;
+  opt.url = url;
+  opt.cancel = cancel;
+  opt.on_tick = [&](const agg::Aggregator& agg) -> std::string {
+    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    bar.update(agg.received(), agg.total());
+    most_workers = std::max(most_workers, agg.live_workers());
+    for (; refusals_shown < agg.refusals().size(); ++refusals_shown)
+      std::fprintf(stderr, "dicesim: warning: %s\n", agg.refusals()[refusals_shown].c_str());
+    if (agg.live_workers() > 0) {
+      idle_since = -1.0;
+    } else if (idle_since < 0) {
+      idle_since = now;
+    } else if (workers == 0 && now - idle_since > 5.0 && now - last_hint > 30.0) {
+      last_hint = now;
+      std::fprintf(stderr, "dicesim: waiting for workers on %s (start some: dicesim worker --lcm '%s')\n", url.c_str(),
+                   url.c_str());
+    }
+    if (a.timeout_s > 0 && now > a.timeout_s)
+      return "timed out after " + std::to_string(a.timeout_s) + " s with " + std::to_string(agg.received()) + " of " +
+             std::to_string(agg.total()) + " tosses";
+    return on_tick ? on_tick() : std::string();
+  };
+  const agg::SessionResult res = agg::run_session(opt, cfg);
+  bar.finish();
+  std::fprintf(stderr, "dicesim: run %lld: %s\n", static_cast<long long>(spec.run_id),
+               agg::health_line(res.health).c_str());
+  if (res.end == agg::SessionEnd::Cancelled) {
+    std::fprintf(stderr, "dicesim: interrupted\n");
+    return kExitFailed;
+  }
+  if (res.end == agg::SessionEnd::Failed) {
+    std::fprintf(stderr, "dicesim: failed: %s\n", res.error.c_str());
+    return kExitFailed;
+  }
+  if (a.target_halfwidth > 0) {
+    const bool reached = agg::halfwidth_reached(res.counts, a.target_halfwidth);
+    std::fprintf(stderr, "dicesim: target half-width %g %s after %llu tosses (widest: %.5f)\n", a.target_halfwidth,
+                 reached ? "reached" : "NOT reached", static_cast<unsigned long long>(res.tosses),
+                 agg::max_halfwidth(res.counts));
+  }
+
+  RunReport r;
+  r.scene = a.scene.path;
+  r.fidelity = spec.fidelity;
+  r.seed = a.seed;
+  r.threads = workers > 0 ? workers : std::max(1, most_workers);
+  r.tosses = res.tosses;
+  r.counts = res.counts;
+  r.labels = model.face_labels;
+  r.elapsed_s = res.elapsed_s;
+  if (a.json)
+    std::printf("%s\n", report_json(r).dump().c_str());
+  else
+    std::printf("%s", report_table(r).c_str());
+  return kExitOk;
+}
+
+void register_aggregate(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<AggregateArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "aggregate",
+      "Start a distributed run over LCM and collect it: announce the scene, lease index ranges to\n"
+      "every `dicesim worker` on the bus, drop duplicates, re-lease what got lost, publish running\n"
+      "probabilities on DICESIM_PROBABILITIES, and print the same table / JSON as `dicesim toss`\n"
+      "(identical counts for the same scene, fidelity, seed and N).\n\n"
+      "Examples:\n"
+      "  dicesim worker & dicesim worker &\n"
+      "  dicesim aggregate scenes/paper/die1.toml --tosses 1000000\n"
+      "  dicesim aggregate scenes/paper/die2.toml --seed 7 --json --lcm 'udpm://239.255.76.67:7667?ttl=1'\n"
+      "  dicesim aggregate scenes/fair.toml --target-halfwidth 0.002 --trace-every 1000");
+  args->add_to(cmd);
+  cmd->callback([args, &exit_code] {
+    std::signal(SIGINT, on_stop_signal);
+    std::signal(SIGTERM, on_stop_signal);
+    exit_code = aggregate_and_report(*args, wire::resolve_url(args->lcm), 0, 0, {}, &g_stop);
+  });
+}
+
+}  // namespace dicesim

@@ -1,0 +1,244 @@
+// dicesim bench tradeoff: the fidelity ladder's speed against its accuracy, measured. The same toss
+// indices go through every fidelity and a ladder of its accuracy settings; the reference is
+// `stepped` at its finest step.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/commands.hpp"
+#include "sim/agreement.hpp"
+#include "sim/die_model.hpp"
+#include "sim/scene_error.hpp"
+#include "sim/toss.hpp"
+
+namespace dicesim {
+namespace {
+
+struct TradeoffArgs {
+  SceneArgs scene;
+  std::uint64_t tosses = 20000;
+  std::uint64_t seed = 1;
+  int threads = 1;
+  bool json = false;
+  std::string csv, plot;
+  std::vector<double> steps = {2e-3, 1e-3, 5e-4, 2e-4};  // the last one is the reference
+};
+
+struct Setting {
+  Fidelity fidelity;
+  std::string label;  // e.g. "step=0.0005"
+  double step = 0.0;  // sim.step (stepped) or sim.contact_step (impulse); 0: not used
+};
+
+struct Row {
+  Setting setting;
+  std::vector<std::int8_t> faces;  // per toss index: face index, -1 if not settled
+  std::array<std::uint64_t, 6> counts{};
+  std::uint64_t settled = 0, unresolved = 0, invalid = 0;
+  double seconds = 0.0;
+  double tosses_per_s = 0.0;
+  double same_face = 0.0;
+  Agreement vs_ref;
+};
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+void run_row(const SceneDef& base, const TradeoffArgs& a, Row& row) {
+  SceneDef sd = base;
+  sd.sim.fidelity = row.setting.fidelity;
+  if (row.setting.fidelity == Fidelity::Stepped) sd.sim.step = row.setting.step;
+  if (row.setting.fidelity == Fidelity::Impulse) sd.sim.contact_step = row.setting.step;
+  const DieModel m = compile(sd, a.scene.path);
+  row.faces.assign(a.tosses, -1);
+  std::vector<std::array<std::uint64_t, 3>> status(static_cast<std::size_t>(a.threads));
+  const auto t0 = std::chrono::steady_clock::now();
+  {
+    std::vector<std::jthread> pool;
+    for (int k = 0; k < a.threads; ++k)
+      pool.emplace_back([&, k] {
+        for (std::uint64_t i = static_cast<std::uint64_t>(k); i < a.tosses; i += static_cast<std::uint64_t>(a.threads)) {
+          const TossResult r = toss(m, a.seed, i);
+          if (r.status == TossStatus::Settled) row.faces[i] = static_cast<std::int8_t>(r.face_index);
+          ++status[static_cast<std::size_t>(k)][static_cast<int>(r.status)];
+        }
+      });
+  }
+  row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  row.tosses_per_s = static_cast<double>(a.tosses) / row.seconds;
+  for (const auto& s : status) {
+    row.settled += s[0];
+    row.unresolved += s[1];
+    row.invalid += s[2];
+  }
+  for (std::int8_t f : row.faces)
+    if (f >= 0) ++row.counts[static_cast<std::size_t>(f)];
+}
+
+void write_csv(std::FILE* out, const std::vector<Row>& rows) {
+  std::fprintf(out, "fidelity,setting,tosses_per_s,same_face,tv,tv_noise,chi2_p,settled,unresolved,invalid\n");
+  for (const Row& r : rows)
+    std::fprintf(out, "%s,%s,%.6g,%.6f,%.6g,%.6g,%.6g,%llu,%llu,%llu\n", to_string(r.setting.fidelity),
+                 r.setting.label.c_str(), r.tosses_per_s, r.same_face, r.vs_ref.tv, r.vs_ref.tv_noise, r.vs_ref.chi2_p,
+                 static_cast<unsigned long long>(r.settled), static_cast<unsigned long long>(r.unresolved),
+                 static_cast<unsigned long long>(r.invalid));
+}
+
+}  // namespace
+
+// Exposed for scripts/plot-tradeoff's sake: the same gnuplot program from a CSV written above.
+int plot_tradeoff_csv(const std::string& csv, const std::string& png, const std::string& title) {
+  const std::string script =
+      "set terminal pngcairo size 1000,620 noenhanced\n"
+      "set output '" + png + "'\n"
+      "set datafile separator ','\n"
+      "set title '" + title + "'\n"
+      "set logscale xy\n"
+      "set xlabel 'tosses per second'\n"
+      "set ylabel 'distance from the reference (stepped, finest step)'\n"
+      "set key inside left bottom box opaque\n"
+      "set grid\nset yrange [1e-3:2]\n"
+      "plot '" + csv + "' skip 1 using 3:(column(5) > 0 ? column(5) : 1/0):(sprintf('%s %s', strcol(1), strcol(2))) "
+      "with labels point pt 7 ps 1.2 offset char 1,0.6 font ',8' title 'total variation vs reference', "
+      "'' skip 1 using 3:6 with points pt 6 ps 1.5 title 'noise level of the total variation', "
+      "'' skip 1 using 3:(1 - column(4) > 0 ? 1 - column(4) : 1/0) with points pt 5 ps 1 title '1 - same face fraction'\n";
+  std::FILE* gp = popen("gnuplot", "w");
+  if (!gp) return kExitFailed;
+  std::fputs(script.c_str(), gp);
+  return pclose(gp) == 0 ? kExitOk : kExitFailed;
+}
+
+namespace {
+
+int run_tradeoff(const TradeoffArgs& a) {
+  const SceneDef base = a.scene.load();
+  (void)compile(base, a.scene.path);  // bad scenes fail before any work
+  std::vector<Row> rows;
+  rows.push_back({{Fidelity::Static, "-", 0.0}});
+  rows.push_back({{Fidelity::Paper, "stop_speed=" + num(base.sim.stop_speed), 0.0}});
+  for (double s : a.steps) rows.push_back({{Fidelity::Impulse, "contact_step=" + num(s), s}});
+  for (double s : a.steps) rows.push_back({{Fidelity::Stepped, "step=" + num(s), s}});
+  for (Row& r : rows) {
+    if (!a.json) std::fprintf(stderr, "  %-8s %-20s ...\r", to_string(r.setting.fidelity), r.setting.label.c_str());
+    run_row(base, a, r);
+  }
+  const Row& ref = rows.back();
+  for (Row& r : rows) {
+    std::uint64_t same = 0, ref_settled = 0;
+    for (std::uint64_t i = 0; i < a.tosses; ++i) {
+      if (ref.faces[i] < 0) continue;
+      ++ref_settled;
+      if (r.faces[i] == ref.faces[i]) ++same;
+    }
+    r.same_face = ref_settled ? static_cast<double>(same) / static_cast<double>(ref_settled) : 0.0;
+    r.vs_ref = agreement_of(r.counts, ref.counts);
+  }
+
+  const auto row_json = [&](const Row& r) {
+    nlohmann::json p = nlohmann::json::object();
+    for (int f = 0; f < 6; ++f)
+      p[std::to_string(base.die.face_labels[f])] = r.settled ? static_cast<double>(r.counts[f]) / r.settled : 0.0;
+    return nlohmann::json{{"fidelity", to_string(r.setting.fidelity)}, {"setting", r.setting.label},
+                          {"tosses_per_s", r.tosses_per_s}, {"same_face", r.same_face},
+                          {"tv", r.vs_ref.tv}, {"tv_noise", r.vs_ref.tv_noise}, {"chi2_p", r.vs_ref.chi2_p},
+                          {"settled", r.settled}, {"unresolved", r.unresolved}, {"invalid", r.invalid},
+                          {"seconds", r.seconds}, {"probabilities", p}};
+  };
+  if (a.json) {
+    nlohmann::json j = {{"scene", a.scene.path}, {"tosses", a.tosses}, {"seed", a.seed}, {"threads", a.threads},
+                        {"reference", row_json(ref)}, {"rows", nlohmann::json::array()}};
+    for (const Row& r : rows) j["rows"].push_back(row_json(r));
+    std::printf("%s\n", j.dump().c_str());
+  } else {
+    std::fprintf(stderr, "%60s\r", "");
+    std::printf("%s: %llu tosses (indices 0..%llu, seed %llu), %d thread%s; reference: stepped %s\n\n",
+                a.scene.path.c_str(), static_cast<unsigned long long>(a.tosses),
+                static_cast<unsigned long long>(a.tosses - 1), static_cast<unsigned long long>(a.seed), a.threads,
+                a.threads == 1 ? "" : "s", ref.setting.label.c_str());
+    std::printf("%-8s %-20s %12s %10s %9s %9s %9s %10s\n", "fidelity", "setting", "tosses/s", "same_face", "tv",
+                "tv_noise", "chi2_p", "unresolved");
+    for (const Row& r : rows)
+      std::printf("%-8s %-20s %12.0f %10.4f %9.5f %9.5f %9.3g %10llu\n", to_string(r.setting.fidelity),
+                  r.setting.label.c_str(), r.tosses_per_s, r.same_face, r.vs_ref.tv, r.vs_ref.tv_noise, r.vs_ref.chi2_p,
+                  static_cast<unsigned long long>(r.unresolved));
+    std::printf("\nsame_face: fraction of toss indices whose face equals the reference's; tv: total-variation\n"
+                "distance of the probability vectors; tv_noise: its expected size from sampling alone;\n"
+                "chi2_p: chi-square homogeneity p-value against the reference (small: a real difference).\n");
+  }
+  if (!a.csv.empty()) {
+    std::FILE* f = std::fopen(a.csv.c_str(), "w");
+    if (!f) throw SceneError(a.csv, "--csv", a.csv, "cannot write this file");
+    write_csv(f, rows);
+    std::fclose(f);
+  }
+  if (!a.plot.empty()) {
+    const std::string tmp = a.plot + ".csv.tmp";
+    std::FILE* f = std::fopen(tmp.c_str(), "w");
+    if (!f) throw SceneError(a.plot, "--plot", a.plot, "cannot write next to this file");
+    write_csv(f, rows);
+    std::fclose(f);
+    const int rc = plot_tradeoff_csv(tmp, a.plot, a.scene.path + ": accuracy against speed");
+    std::remove(tmp.c_str());
+    if (rc != kExitOk) {
+      std::fprintf(stderr, "dicesim: failed: gnuplot could not draw %s (is gnuplot-nox installed? scripts/setup)\n",
+                   a.plot.c_str());
+      return kExitFailed;
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int run_bench_tradeoff(int argc, char** argv) {
+  auto a = std::make_shared<TradeoffArgs>();
+  CLI::App app{
+      "Speed against accuracy along the fidelity ladder: the same toss indices through static, paper,\n"
+      "impulse (a ladder of contact steps) and stepped (a ladder of steps); the reference is stepped at\n"
+      "its finest step. Per row: tosses/s, same_face, tv, tv_noise, chi2_p.\n\n"
+      "Example:  dicesim bench tradeoff scenes/paper/die1.toml --tosses 20000 --plot die1.png",
+      "dicesim bench tradeoff"};
+  a->scene.add_to(&app);
+  app.add_option("-n,--tosses", a->tosses, "Tosses per row")->capture_default_str()->check(CLI::Range(1ULL, 1ULL << 32));
+  app.add_option("--seed", a->seed, "Run seed")->capture_default_str();
+  app.add_option("-j,--threads", a->threads, "Threads (tosses/s is for all of them together)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1024));
+  app.add_option("--steps", a->steps, "Ladder of steps (s) for impulse's contact_step and stepped's step; the last "
+                                      "one is the reference")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-7, 1e-2));
+  app.add_flag("--json", a->json, "One JSON object {scene, tosses, reference, rows} on stdout");
+  app.add_option("--csv", a->csv, "Also write the rows as CSV to this file")->type_name("FILE");
+  app.add_option("--plot", a->plot, "Also draw accuracy against speed as PNG (gnuplot)")->type_name("FILE.png");
+  int exit_code = kExitOk;
+  app.callback([a, &exit_code] { exit_code = run_tradeoff(*a); });
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "dicesim bench tradeoff: %s\nRun with --help for usage.\n", e.what());
+    return kExitBadInput;
+  } catch (const SceneError& e) {
+    std::fprintf(stderr, "dicesim: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dicesim: failed: %s\n", e.what());
+    return kExitFailed;
+  }
+  return exit_code;
+}
+
+}  // namespace dicesim

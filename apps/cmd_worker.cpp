@@ -1,0 +1,63 @@
+// dicesim worker: a toss-worker process for distributed runs (sim/worker does the work).
+#include <csignal>
+#include <cstdio>
+
+#include "apps/commands.hpp"
+#include "messages/wire.hpp"
+#include "sim/worker/worker.hpp"
+
+namespace dicesim {
+namespace {
+
+std::atomic<bool> g_stop{false};
+void on_stop_signal(int) { g_stop = true; }
+
+struct WorkerArgs {
+  std::string lcm;
+  std::int64_t run = 0;
+  bool once = false;
+  bool quiet = false;
+  int batch = 1024;
+};
+
+int run_worker_cmd(const WorkerArgs& a) {
+  std::signal(SIGINT, on_stop_signal);
+  std::signal(SIGTERM, on_stop_signal);
+  worker::WorkerOptions opt;
+  opt.url = wire::resolve_url(a.lcm);
+  opt.once = a.once;
+  opt.cancel = &g_stop;
+  opt.core.only_run = a.run;
+  opt.core.batch = a.batch;
+  if (!a.quiet) opt.core.log = [](const std::string& s) { std::fprintf(stderr, "dicesim worker: %s\n", s.c_str()); };
+  const int code = worker::run_worker(opt);
+  if (code != 0) std::fprintf(stderr, "dicesim worker: failed: cannot open LCM at '%s'\n", opt.url.c_str());
+  return code == 0 ? kExitOk : kExitFailed;
+}
+
+}  // namespace
+
+void register_worker(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<WorkerArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "worker",
+      "Serve distributed runs: wait for a run (dicesim aggregate / dicesim run), take the index\n"
+      "ranges leased to this process, toss them and publish the results over LCM. Runs until\n"
+      "Ctrl-C (or, with --once, until its run ends). Start one per core; they may join at any time.\n\n"
+      "Examples:\n"
+      "  dicesim worker                                   # host-confined default URL\n"
+      "  dicesim worker --lcm 'udpm://239.255.76.67:7667?ttl=1'   # a LAN: see README, Scale-out\n"
+      "  LCM_DEFAULT_URL='udpm://239.255.76.67:7700?ttl=0' dicesim worker --once");
+  cmd->add_option("--lcm", args->lcm,
+                  "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0, which never leaves this host)")
+      ->type_name("URL");
+  cmd->add_option("--run", args->run, "Serve only the run with this id (dicesim run uses it)")->type_name("ID");
+  cmd->add_flag("--once", args->once, "Exit after the first run served ends");
+  cmd->add_option("--batch", args->batch, "Tosses per published batch")
+      ->capture_default_str()
+      ->check(CLI::Range(1, wire::kMaxBatch));
+  cmd->add_flag("-q,--quiet", args->quiet, "No log lines on stderr");
+  cmd->callback([args, &exit_code] { exit_code = run_worker_cmd(*args); });
+}
+
+}  // namespace dicesim

@@ -1,0 +1,50 @@
+// What a run is, as run_start carries it: the scene files (the main one and every file it
+// `extends`), the overrides, the seed and the size. Both sides rebuild the model through the
+// same load_scene() call as `dicesim toss`, so a worker's model is the aggregator's model; a
+// fingerprint of the compiled model proves it (a mismatched build refuses the run).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "dicesim_lcm/run_start.hpp"
+#include "sim/die_model.hpp"
+
+namespace dicesim::wire {
+
+struct SceneFile {
+  std::string path;  // relative to the files' common root, '/'-separated
+  std::string text;
+};
+
+struct RunSpec {
+  std::int64_t run_id = 0;
+  std::string origin;              // as the user typed it
+  std::vector<SceneFile> files;    // files[0] is the scene itself, then its bases
+  std::vector<std::string> overrides;
+  std::string fidelity;
+  std::uint64_t seed = 1;
+  std::uint64_t total = 0;
+  int trace_every = 0;
+  std::uint64_t fingerprint = 0;   // model_fingerprint of the compiled model
+  std::string hash;                // scene_hash()
+};
+
+// Reads `path` and the files it extends (throws SceneError if unreadable). Does not compile.
+std::vector<SceneFile> read_scene_files(const std::string& path);
+
+// FNV-1a 64 over every path, text and override (hex): names the exact input of a run.
+std::string scene_hash(const std::vector<SceneFile>& files, const std::vector<std::string>& overrides);
+
+// Hash of everything in a compiled model that a toss reads (bit patterns of the doubles).
+std::uint64_t model_fingerprint(const DieModel& m);
+
+// Writes the files into a private temporary directory, loads and compiles them exactly as
+// `dicesim toss` would load the original, and removes the directory. Throws SceneError.
+DieModel compile_spec(const RunSpec& spec);
+
+dicesim_lcm::run_start to_message(const RunSpec& spec);
+RunSpec from_message(const dicesim_lcm::run_start& msg);
+
+}  // namespace dicesim::wire

@@ -1,0 +1,84 @@
+#include "messages/wire.hpp"
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+
+namespace dicesim::wire {
+
+std::string resolve_url(const std::string& flag) {
+  if (!flag.empty()) return flag;
+  if (const char* env = std::getenv("LCM_DEFAULT_URL"); env && *env) return env;
+  return kDefaultUrl;
+}
+
+std::int64_t now_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+namespace {
+
+// Reads an LCM encoding (big-endian) without trusting it: every step checks the bytes left.
+class Walker {
+ public:
+  Walker(const void* d, std::size_t n) : p_(static_cast<const std::uint8_t*>(d)), n_(n) {}
+  bool skip(std::size_t k) {
+    if (k > n_ - pos_) return false;
+    pos_ += k;
+    return true;
+  }
+  bool i32(std::int32_t& v) {
+    if (4 > n_ - pos_) return false;
+    const std::uint32_t u = (std::uint32_t{p_[pos_]} << 24) | (std::uint32_t{p_[pos_ + 1]} << 16) |
+                            (std::uint32_t{p_[pos_ + 2]} << 8) | std::uint32_t{p_[pos_ + 3]};
+    std::memcpy(&v, &u, 4);
+    pos_ += 4;
+    return true;
+  }
+  // A string: int32 length including the terminating NUL (>= 1), then the bytes.
+  bool str() {
+    std::int32_t len;
+    return i32(len) && len >= 1 && skip(static_cast<std::size_t>(len));
+  }
+  // A count for an array of elements of at least `min_size` bytes each.
+  bool count(std::int32_t& c, std::size_t min_size) {
+    return i32(c) && c >= 0 && static_cast<std::size_t>(c) * min_size <= n_ - pos_;
+  }
+  bool at_end() const { return pos_ == n_; }
+
+ private:
+  const std::uint8_t* p_;
+  std::size_t n_, pos_ = 0;
+};
+
+}  // namespace
+
+bool plausible_run_start(const void* data, std::size_t len) {
+  Walker w(data, len);
+  std::int32_t n = 0;
+  if (!w.skip(8 + 8 + 8) || !w.str() || !w.str() || !w.str()) return false;  // hash utime run_id origin path text
+  if (!w.count(n, 5)) return false;
+  for (int pass = 0; pass < 2; ++pass)
+    for (std::int32_t i = 0; i < n; ++i)
+      if (!w.str()) return false;
+  if (!w.count(n, 5)) return false;
+  for (std::int32_t i = 0; i < n; ++i)
+    if (!w.str()) return false;
+  return w.str() && w.skip(8) && w.str() && w.skip(8 + 8 + 4) && w.at_end();
+}
+
+bool plausible_toss_batch(const void* data, std::size_t len) {
+  Walker w(data, len);
+  std::int32_t n = 0;
+  return w.skip(8 + 5 * 8) && w.count(n, 6) && n <= kMaxBatch && w.skip(static_cast<std::size_t>(n) * 6) && w.at_end();
+}
+
+bool plausible_worker_status(const void* data, std::size_t len) {
+  Walker w(data, len);
+  std::int32_t n = 0;
+  return w.skip(8 + 3 * 8 + 4) && w.str() && w.skip(1) && w.str() && w.count(n, 8) &&
+         w.skip(static_cast<std::size_t>(n) * 8) && w.skip(8 + 8 + 8 + 8) && w.at_end();
+}
+
+}  // namespace dicesim::wire

@@ -1,0 +1,253 @@
+#include "sim/worker/worker.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <random>
+
+#include <Eigen/Geometry>
+#include <lcm/lcm-cpp.hpp>
+
+#include "sim/scene_error.hpp"
+#include "sim/toss.hpp"
+
+namespace dicesim::worker {
+namespace {
+
+std::int64_t random_id() {
+  std::random_device rd;
+  std::uint64_t v = 0;
+  while (v == 0) v = ((std::uint64_t{rd()} << 32) ^ rd() ^ static_cast<std::uint64_t>(getpid())) & INT64_MAX;
+  return static_cast<std::int64_t>(v);
+}
+
+std::string hostname() {
+  char buf[256] = {};
+  gethostname(buf, sizeof buf - 1);
+  return buf;
+}
+
+void put3(double (&out)[3], const Vec3& v) {
+  for (int i = 0; i < 3; ++i) out[i] = v[i];
+}
+
+}  // namespace
+
+WorkerCore::WorkerCore(WorkerConfig cfg, Send send) : cfg_(std::move(cfg)), send_(std::move(send)), host_(hostname()) {
+  if (cfg_.worker_id == 0) cfg_.worker_id = random_id();
+  cfg_.batch = std::clamp(cfg_.batch, 1, wire::kMaxBatch);
+}
+
+void WorkerCore::on_message(std::string_view channel, const void* data, std::size_t len, double now) {
+  if (channel == wire::kRunStart) {
+    if (auto m = wire::decode<dicesim_lcm::run_start>(data, len)) return on_run_start(*m, now);
+  } else if (channel == wire::kWorkLease) {
+    if (auto m = wire::decode<dicesim_lcm::work_lease>(data, len)) return on_lease(*m);
+  } else if (channel == wire::kProbabilities) {
+    if (auto m = wire::decode<dicesim_lcm::probabilities>(data, len)) {
+      if (run_ && m->run_id == run_->spec.run_id && m->finished == 1) end_run("finished");
+      return;
+    }
+  } else {
+    return;  // not a channel a worker listens to
+  }
+  ++ignored_;
+}
+
+void WorkerCore::on_run_start(const dicesim_lcm::run_start& m, double now) {
+  if (m.run_id == 0 || (cfg_.only_run != 0 && m.run_id != cfg_.only_run) || ended_runs_.count(m.run_id)) return;
+  if (run_ && run_->spec.run_id == m.run_id) {
+    run_->last_heard = now;
+    return;
+  }
+  if (run_ && now - run_->last_heard < cfg_.run_silence_s) return;  // busy with another live run
+  if (run_) end_run("replaced by a newer run");
+  run_ = std::make_unique<Run>();
+  run_->spec = wire::from_message(m);
+  run_->last_heard = now;
+  leases_.clear();
+  last_lease_seen_ = last_done_ = 0;
+  tosses_done_ = rate_n_ = 0;
+  rate_t_ = now;
+  try {
+    if (m.total_tosses <= 0 || m.seed < 0) throw std::runtime_error("total_tosses and seed must be positive");
+    DieModel model = wire::compile_spec(run_->spec);
+    if (wire::model_fingerprint(model) != run_->spec.fingerprint)
+      throw std::runtime_error("the model compiled here differs from the aggregator's (fingerprint mismatch: "
+                               "a different dicesim build?)");
+    run_->model = std::move(model);
+  } catch (const std::exception& e) {  // SceneError or anything else: refuse, say why
+    run_->error = e.what();
+  }
+  if (cfg_.log)
+    cfg_.log(run_->model ? "run " + std::to_string(m.run_id) + ": " + m.origin + ", " + std::to_string(m.total_tosses) +
+                               " tosses, seed " + std::to_string(m.seed)
+                         : "refusing run " + std::to_string(m.run_id) + ": " + run_->error);
+  send_status(now);
+}
+
+void WorkerCore::on_lease(const dicesim_lcm::work_lease& m) {
+  if (!run_ || !run_->model || m.run_id != run_->spec.run_id || m.worker_id != cfg_.worker_id) return;
+  const std::uint64_t total = run_->spec.total;
+  if (m.lease_id <= last_done_ || m.count <= 0 || m.first_index < 0 || static_cast<std::uint64_t>(m.first_index) >= total ||
+      static_cast<std::uint64_t>(m.count) > total - static_cast<std::uint64_t>(m.first_index) || leases_.size() >= 16) {
+    ++ignored_;
+    return;
+  }
+  for (const Lease& l : leases_)
+    if (l.id == m.lease_id) return;
+  const std::uint64_t first = static_cast<std::uint64_t>(m.first_index);
+  Lease l{m.lease_id, first, first + static_cast<std::uint64_t>(m.count)};
+  leases_.insert(std::upper_bound(leases_.begin(), leases_.end(), l, [](const Lease& a, const Lease& b) { return a.id < b.id; }),
+                 l);
+  last_lease_seen_ = std::max(last_lease_seen_, m.lease_id);
+}
+
+void WorkerCore::end_run(const char* why) {
+  if (!run_) return;
+  if (cfg_.log)
+    cfg_.log("run " + std::to_string(run_->spec.run_id) + " ended: " + why + " (" + std::to_string(tosses_done_) +
+             " tosses by this worker)");
+  ended_runs_.insert(run_->spec.run_id);
+  run_.reset();
+  leases_.clear();
+  ++runs_finished_;
+}
+
+void WorkerCore::send_status(double now) {
+  last_status_ = now;
+  dicesim_lcm::worker_status s;
+  s.utime = wire::now_utime();
+  s.worker_id = cfg_.worker_id;
+  s.run_id = run_ ? run_->spec.run_id : 0;
+  s.pid = static_cast<std::int32_t>(getpid());
+  s.host = host_;
+  s.state = !run_ ? 0 : run_->model ? 1 : 2;
+  s.error = run_ ? run_->error : "";
+  for (const Lease& l : leases_) s.held_leases.push_back(l.id);
+  s.n_held = static_cast<std::int32_t>(s.held_leases.size());
+  s.last_done_lease = last_done_;
+  s.tosses_done = static_cast<std::int64_t>(tosses_done_);
+  s.tosses_per_s = rate_;
+  s.traces_skipped = static_cast<std::int64_t>(traces_skipped_);
+  send_(wire::kWorkerStatus, wire::encode(s));
+}
+
+void WorkerCore::tick(double now) {
+  if (run_ && now - run_->last_heard > cfg_.run_silence_s) end_run("no run_start heard for a while");
+  if (now - rate_t_ >= 1.0) {
+    rate_ = static_cast<double>(tosses_done_ - rate_n_) / (now - rate_t_);
+    rate_t_ = now;
+    rate_n_ = tosses_done_;
+  }
+  if (now - last_status_ >= cfg_.heartbeat_s) send_status(now);
+}
+
+bool WorkerCore::step(double now) {
+  if (!run_ || !run_->model || leases_.empty()) return false;
+  const DieModel& model = *run_->model;
+  const wire::RunSpec& spec = run_->spec;
+  Lease& l = leases_.front();
+  const std::uint64_t n = std::min<std::uint64_t>(static_cast<std::uint64_t>(cfg_.batch), l.end - l.next);
+
+  // Bounce-state budget for this batch: a token bucket refilled at max_trace_per_s.
+  trace_tokens_ = std::min(cfg_.max_trace_per_s, trace_tokens_ + (now - trace_t_) * cfg_.max_trace_per_s);
+  trace_t_ = now;
+
+  dicesim_lcm::toss_batch b;
+  b.utime = wire::now_utime();
+  b.run_id = spec.run_id;
+  b.worker_id = cfg_.worker_id;
+  b.lease_id = l.id;
+  b.first_index = static_cast<std::int64_t>(l.next);
+  b.count = static_cast<std::int32_t>(n);
+  b.faces.resize(n);
+  b.statuses.resize(n);
+  b.bounces.resize(n);
+  std::vector<BounceRecord> records;
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const std::uint64_t i = l.next + k;
+    const bool traced = spec.trace_every > 0 && i % static_cast<std::uint64_t>(spec.trace_every) == 0;
+    TossProbe probe;
+    records.clear();
+    probe.trace = &records;
+    // The probe only records: the result is the same toss as without it.
+    const TossResult r = toss(model, spec.seed, i, traced ? &probe : nullptr);
+    b.faces[k] = static_cast<std::int8_t>(r.status == TossStatus::Settled ? r.face : 0);
+    b.statuses[k] = static_cast<std::int8_t>(r.status);
+    b.bounces[k] = r.bounces;
+    for (const BounceRecord& rec : records) {
+      if (trace_tokens_ < 1.0) {
+        ++traces_skipped_;
+        continue;
+      }
+      trace_tokens_ -= 1.0;
+      dicesim_lcm::bounce_state s;
+      s.utime = b.utime;
+      s.run_id = spec.run_id;
+      s.worker_id = cfg_.worker_id;
+      s.toss_index = static_cast<std::int64_t>(i);
+      s.bounce = rec.bounce;
+      s.t = rec.t;
+      put3(s.position, rec.before.position);
+      const Eigen::Quaterniond q(rec.before.R);
+      s.quaternion[0] = q.w(), s.quaternion[1] = q.x(), s.quaternion[2] = q.y(), s.quaternion[3] = q.z();
+      put3(s.velocity, rec.before.velocity);
+      put3(s.angular_velocity, rec.before.omega);
+      put3(s.velocity_after, rec.after.velocity);
+      put3(s.angular_velocity_after, rec.after.omega);
+      s.contact_vertex = rec.vertex;
+      s.impulse = rec.impulse;
+      send_(wire::kBounceState, wire::encode(s));
+    }
+  }
+  send_(wire::kTossBatch, wire::encode(b));
+  l.next += n;
+  tosses_done_ += n;
+  if (l.next == l.end) {
+    last_done_ = l.id;
+    leases_.pop_front();
+    send_status(now);  // "done with that one": the aggregator may re-lease what it did not get
+  }
+  return true;
+}
+
+namespace {
+struct Inbox {
+  WorkerCore* core;
+  std::chrono::steady_clock::time_point t0;
+  void handle(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    core->on_message(channel, rbuf->data, rbuf->data_size,
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+};
+}  // namespace
+
+int run_worker(const WorkerOptions& opt) {
+  lcm::LCM bus(opt.url);
+  if (!bus.good()) {
+    if (opt.core.log) opt.core.log("cannot open LCM at '" + opt.url + "'");
+    return 1;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  WorkerCore core(opt.core, [&bus](const char* channel, const std::vector<std::uint8_t>& bytes) {
+    bus.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+  });
+  Inbox inbox{&core, t0};
+  for (const char* ch : {wire::kRunStart, wire::kWorkLease, wire::kProbabilities})
+    bus.subscribe(ch, &Inbox::handle, &inbox)->setQueueCapacity(4096);
+  if (opt.core.log) opt.core.log("worker " + std::to_string(core.id()) + " listening on " + opt.url);
+  for (;;) {
+    if (opt.cancel && opt.cancel->load()) break;
+    while (bus.handleTimeout(0) > 0) {
+    }
+    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    core.tick(now);
+    if (opt.once && core.runs_finished() > 0) break;
+    if (!core.step(now)) bus.handleTimeout(50);
+  }
+  return 0;
+}
+
+}  // namespace dicesim::worker

@@ -1,0 +1,94 @@
+// The toss worker: hears run_start, rebuilds the run's model, takes the leases addressed to it,
+// simulates them in index order and publishes toss_batch messages (and, when the run asks,
+// sampled bounce states). Like the aggregator, the logic (WorkerCore) is free of sockets and
+// clocks; run_worker() drives it on a live LCM bus.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "messages/run_spec.hpp"
+#include "messages/wire.hpp"
+#include "sim/die_model.hpp"
+
+namespace dicesim::worker {
+
+struct WorkerConfig {
+  std::int64_t worker_id = 0;        // 0: pick a random one
+  std::int64_t only_run = 0;         // non-zero: serve only this run id
+  int batch = 1024;                  // tosses per toss_batch (<= wire::kMaxBatch)
+  double heartbeat_s = 0.2;
+  double run_silence_s = 5.0;        // no run_start for this long: the run is gone
+  double max_trace_per_s = 2000.0;   // bounce_state messages per second at most (publishers pace themselves)
+  std::function<void(const std::string&)> log;  // human-readable events (stderr)
+};
+
+class WorkerCore {
+ public:
+  using Send = std::function<void(const char* channel, const std::vector<std::uint8_t>& bytes)>;
+  WorkerCore(WorkerConfig cfg, Send send);
+
+  void on_message(std::string_view channel, const void* data, std::size_t len, double now);
+  // Heartbeats and run expiry. Call often (every batch and every idle wait).
+  void tick(double now);
+  // Simulates and publishes one batch of the current lease; false when there is nothing to do.
+  bool step(double now);
+
+  std::int64_t id() const { return cfg_.worker_id; }
+  std::int64_t run_id() const { return run_ ? run_->spec.run_id : 0; }
+  int runs_finished() const { return runs_finished_; }
+  std::uint64_t tosses_done() const { return tosses_done_; }
+  std::uint64_t ignored() const { return ignored_; }  // undecodable or inapplicable messages
+
+ private:
+  struct Run {
+    wire::RunSpec spec;
+    std::optional<DieModel> model;  // empty: refused (error says why)
+    std::string error;
+    double last_heard = 0.0;
+  };
+  struct Lease {
+    std::int64_t id;
+    std::uint64_t next, end;
+  };
+
+  void on_run_start(const dicesim_lcm::run_start& m, double now);
+  void on_lease(const dicesim_lcm::work_lease& m);
+  void end_run(const char* why);
+  void send_status(double now);
+  void trace(std::uint64_t index, double now);
+
+  WorkerConfig cfg_;
+  Send send_;
+  std::unique_ptr<Run> run_;
+  std::set<std::int64_t> ended_runs_;
+  std::deque<Lease> leases_;
+  std::int64_t last_lease_seen_ = 0, last_done_ = 0;
+  std::uint64_t tosses_done_ = 0, ignored_ = 0, traces_skipped_ = 0;
+  int runs_finished_ = 0;
+  double last_status_ = -1e9;
+  double rate_ = 0.0, rate_t_ = 0.0;
+  std::uint64_t rate_n_ = 0;
+  double trace_tokens_ = 0.0, trace_t_ = 0.0;
+  std::string host_;
+};
+
+struct WorkerOptions {
+  std::string url;                            // resolved
+  WorkerConfig core;
+  bool once = false;                          // exit after the first run it served ends
+  const std::atomic<bool>* cancel = nullptr;  // set from a signal handler
+};
+
+// 0 when cancelled or (with once) after a run; 1 if LCM cannot be opened.
+int run_worker(const WorkerOptions& opt);
+
+}  // namespace dicesim::worker

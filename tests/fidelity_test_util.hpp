@@ -1,0 +1,43 @@
+// Helpers shared by the fidelity-ladder tests (test_fidelity_*, test_friction*, test_rest*, test_extremes*).
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "scenes_for_tests.hpp"
+#include "sim/die_model.hpp"
+#include "sim/monte_carlo.hpp"
+
+namespace dicesim::testing {
+
+inline SceneDef with_fidelity(SceneDef s, Fidelity f) {
+  s.sim.fidelity = f;
+  return s;
+}
+
+// A die released at rest in a fixed orientation (z-x-z Euler degrees) with its lowest corner on
+// the floor (drop height 0).
+inline SceneDef at_rest(SceneDef s, const Vec3& euler_deg) {
+  s.throw_.orientation.kind = OrientationKind::Fixed;
+  s.throw_.orientation.euler_deg = euler_deg;
+  s.throw_.velocity = {Vec3::Zero(), Vec3::Zero()};
+  s.throw_.spin.kind = SpinKind::Normal;
+  s.throw_.spin.components = {Vec3::Zero(), Vec3::Zero()};
+  const DieModel probe = compile(s);
+  const Vec3 e = euler_deg * (kPi / 180.0);
+  const Mat3 R = euler_zxz(e.x(), e.y(), e.z()) * probe.geo_to_body.transpose();
+  double depth = 0.0;
+  for (const Vec3& v : probe.vertices) depth = std::max(depth, -(R * v).z());
+  s.throw_.height = {depth, 0.0};
+  return s;
+}
+
+inline RunCounts run(const DieModel& m, std::uint64_t n, std::uint64_t seed = 1, int threads = 2) {
+  RunConfig cfg;
+  cfg.seed = seed;
+  cfg.tosses = n;
+  cfg.threads = threads;
+  return run_tosses(m, cfg);
+}
+
+}  // namespace dicesim::testing

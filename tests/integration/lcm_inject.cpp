@@ -1,0 +1,165 @@
+// Test helper for the LCM integration scenarios (tests/integration/lcm_scenarios.sh).
+//   lcm_inject hostile        waits for a run_start, then publishes foreign, out-of-range,
+//                             out-of-domain, truncated and garbage messages on every channel
+//   lcm_inject progress FRACTION SECONDS
+//                             returns 0 as soon as a running run has done >= FRACTION of its
+//                             tosses (from DICESIM_PROBABILITIES); 1 if it finished or time ran out
+//   lcm_inject count CHANNEL SECONDS
+//                             prints how many valid messages of CHANNEL's type arrived
+//                             (after SECONDS, or at SIGTERM)
+// URL: $LCM_DEFAULT_URL (the scenario's private namespace).
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string>
+#include <thread>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "messages/wire.hpp"
+
+namespace w = dicesim::wire;
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+void on_term(int) { g_stop = true; }
+
+struct Listener {
+  std::string want;
+  int count = 0;
+  dicesim_lcm::run_start run;
+  bool have_run = false;
+  double fraction = -1.0;  // progress mode
+  int progress = -1;       // -1 waiting, 0 reached while running, 1 finished first
+  std::int64_t done = 0;
+  void handle(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+    if (ch == w::kRunStart) {
+      if (auto m = w::decode<dicesim_lcm::run_start>(rb->data, rb->data_size)) run = *m, have_run = true;
+    }
+    if (fraction >= 0 && ch == w::kProbabilities && progress < 0) {
+      if (auto m = w::decode<dicesim_lcm::probabilities>(rb->data, rb->data_size)) {
+        done = m->done;
+        if (m->finished) progress = 1;
+        else if (m->total > 0 && static_cast<double>(m->done) >= fraction * static_cast<double>(m->total)) progress = 0;
+      }
+    }
+    if (ch != want) return;
+    bool ok = false;
+    if (ch == w::kBounceState) ok = w::decode<dicesim_lcm::bounce_state>(rb->data, rb->data_size).has_value();
+    else if (ch == w::kProbabilities) ok = w::decode<dicesim_lcm::probabilities>(rb->data, rb->data_size).has_value();
+    else if (ch == w::kTossBatch) ok = w::decode<dicesim_lcm::toss_batch>(rb->data, rb->data_size).has_value();
+    else if (ch == w::kWorkerStatus) ok = w::decode<dicesim_lcm::worker_status>(rb->data, rb->data_size).has_value();
+    count += ok ? 1 : 0;
+  }
+};
+
+template <class T>
+void send(lcm::LCM& bus, const char* ch, const T& m, int* sent) {
+  const auto b = w::encode(m);
+  bus.publish(ch, b.data(), static_cast<unsigned>(b.size()));
+  ++*sent;
+  std::this_thread::sleep_for(std::chrono::milliseconds(2));  // pace: no flood, no drops
+}
+
+void send_raw(lcm::LCM& bus, const char* ch, const std::vector<std::uint8_t>& b, int* sent) {
+  bus.publish(ch, b.data(), static_cast<unsigned>(b.size()));
+  ++*sent;
+  std::this_thread::sleep_for(std::chrono::milliseconds(2));
+}
+
+dicesim_lcm::toss_batch batch(std::int64_t run, std::int64_t first, int n, int face, int status) {
+  dicesim_lcm::toss_batch b{};
+  b.run_id = run;
+  b.worker_id = 42;
+  b.lease_id = 1;
+  b.first_index = first;
+  b.count = n;
+  b.faces.assign(static_cast<std::size_t>(n), static_cast<std::int8_t>(face));
+  b.statuses.assign(static_cast<std::size_t>(n), static_cast<std::int8_t>(status));
+  b.bounces.assign(static_cast<std::size_t>(n), 3);
+  return b;
+}
+
+int hostile(lcm::LCM& bus, Listener& in) {
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!in.have_run) {
+    bus.handleTimeout(100);
+    if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(30)) return 1;
+  }
+  const std::int64_t run = in.run.run_id, total = in.run.total_tosses;
+  int foreign = 0, range = 0, malformed = 0;
+  // Another run's messages on every channel the aggregator reads.
+  send(bus, w::kTossBatch, batch(run + 1, 0, 10, 1, 0), &foreign);
+  dicesim_lcm::worker_status st{};
+  st.run_id = run + 1;
+  st.worker_id = 7;
+  st.state = 1;
+  send(bus, w::kWorkerStatus, st, &foreign);
+  dicesim_lcm::run_start other = in.run;
+  other.run_id = run + 1;
+  other.total_tosses = 5;
+  send(bus, w::kRunStart, other, &foreign);
+  // Indices outside [0, total).
+  send(bus, w::kTossBatch, batch(run, total, 10, 1, 0), &range);
+  send(bus, w::kTossBatch, batch(run, total - 5, 10, 1, 0), &range);
+  send(bus, w::kTossBatch, batch(run, -3, 10, 1, 0), &range);
+  // Fields outside their domain: face 0 or 7 when settled, a face when unresolved, status 3.
+  send(bus, w::kTossBatch, batch(run, 0, 10, 0, 0), &malformed);
+  send(bus, w::kTossBatch, batch(run, 0, 10, 7, 0), &malformed);
+  send(bus, w::kTossBatch, batch(run, 0, 10, 2, 1), &malformed);
+  send(bus, w::kTossBatch, batch(run, 0, 10, 0, 3), &malformed);
+  // Truncated encodings of a valid message, and garbage, on every channel.
+  std::mt19937 rng(12345);
+  const auto good = w::encode(batch(run, 0, 10, 1, 0));
+  for (const char* ch : {w::kRunStart, w::kWorkLease, w::kTossBatch, w::kBounceState, w::kWorkerStatus, w::kProbabilities}) {
+    for (std::size_t cut : {std::size_t{0}, std::size_t{4}, std::size_t{9}, good.size() / 2, good.size() - 1})
+      send_raw(bus, ch, std::vector<std::uint8_t>(good.begin(), good.begin() + static_cast<long>(cut)), &malformed);
+    for (int k = 0; k < 5; ++k) {
+      std::vector<std::uint8_t> junk(static_cast<std::size_t>(rng() % 300));
+      for (auto& c : junk) c = static_cast<std::uint8_t>(rng());
+      if (k == 0 && junk.size() >= 8) {  // the right type hash, then junk: gets past the hash check
+        const auto g = w::encode(batch(run, 0, 1, 1, 0));
+        std::memcpy(junk.data(), g.data(), 8);
+      }
+      send_raw(bus, ch, junk, &malformed);
+    }
+  }
+  // A count that claims 2^31-1 tosses in a 60-byte message.
+  auto huge = w::encode(batch(run, 0, 1, 1, 0));
+  huge[48] = 0x7f, huge[49] = 0xff, huge[50] = 0xff, huge[51] = 0xff;
+  send_raw(bus, w::kTossBatch, huge, &malformed);
+  std::printf("sent foreign %d, out of range %d, malformed %d\n", foreign, range, malformed);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  lcm::LCM bus(w::resolve_url(""));
+  if (!bus.good()) return 2;
+  Listener in;
+  bus.subscribe(".*", &Listener::handle, &in)->setQueueCapacity(100000);
+  const std::string mode = argc > 1 ? argv[1] : "";
+  if (mode == "hostile") return hostile(bus, in);
+  if (mode == "progress" && argc == 4) {
+    in.fraction = std::stod(argv[2]);
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(std::stod(argv[3]));
+    while (in.progress < 0 && std::chrono::steady_clock::now() < end) bus.handleTimeout(20);
+    std::printf("progress: %lld tosses done%s\n", static_cast<long long>(in.done), in.progress == 0 ? "" : " (too late)");
+    return in.progress == 0 ? 0 : 1;
+  }
+  if (mode == "count" && argc == 4) {
+    in.want = argv[2];
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(std::stod(argv[3]));
+    std::signal(SIGTERM, on_term);  // stop early, still print the count
+    while (!g_stop && std::chrono::steady_clock::now() < end) bus.handleTimeout(50);
+    std::printf("%d\n", in.count);
+    return 0;
+  }
+  std::fprintf(stderr, "usage: lcm_inject hostile | progress FRACTION SECONDS | count CHANNEL SECONDS\n");
+  return 2;
+}

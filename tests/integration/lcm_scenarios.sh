@@ -1,0 +1,193 @@
+#!/usr/bin/env bash
+# Distributed-run scenarios with real processes, each inside a private network namespace that
+# this script creates for itself (only loopback, with a multicast route): nothing it sends can
+# leave the namespace. Run by CTest (tests/CMakeLists.txt), one scenario per test:
+#   lcm_scenarios.sh DICESIM_BINARY LCM_INJECT_BINARY SCENARIO
+# Scenarios: three_workers kill9 drop10 replay late_join hostile run_cmd interrupt target trace
+# Every scenario compares the distributed JSON with `dicesim toss --threads 1` after removing
+# only the keys that may differ (elapsed_s, tosses_per_s, threads): identical counts, p, CIs.
+set -euo pipefail
+
+if [ "${DICESIM_NETNS:-}" != "1" ]; then
+  # A private network namespace needs root (CI runs as root); elsewhere CTest reports a skip.
+  if [ "$(id -u)" -ne 0 ]; then echo "SKIP: network namespaces need root"; exit 77; fi
+  exec unshare --net env DICESIM_NETNS=1 "$0" "$@"
+fi
+ip link set lo up
+ip link set lo multicast on
+ip route add 224.0.0.0/4 dev lo
+export LCM_DEFAULT_URL="udpm://239.255.76.67:7667?ttl=0"
+
+bin=$1 inject=$2 scenario=$3
+src_dir=$(cd "$(dirname "$0")/../.." && pwd)
+cd "$src_dir"
+work=$(mktemp -d /tmp/dicesim-it-XXXXXX)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  rm -rf "$work"
+}
+trap cleanup EXIT
+
+scene=scenes/paper/die1.toml
+seed=11
+n=20000
+
+fail() { echo "FAIL [$scenario]: $*" >&2; for f in "$work"/*.err; do echo "--- $f" >&2; tail -n 20 "$f" >&2; done; exit 1; }
+# The JSON without the keys that legitimately differ between runs.
+stable() { sed -E 's/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//; s/"tosses_per_s":[^,}]*,?//' "$1"; }
+# Scenario (a) compares with one thread; the others use two (the counts are the same by
+# construction, tested by (a) and by the unit tests) to keep the suite short.
+reference() { "$bin" toss "$scene" --tosses "$n" --seed "$seed" --threads "${1:-2}" --json > "$work/ref.json"; }
+same_as_reference() {
+  [ -s "$1" ] || fail "no JSON from the distributed run"
+  if [ "$(stable "$work/ref.json")" != "$(stable "$1")" ]; then
+    echo "reference:   $(stable "$work/ref.json")" >&2
+    echo "distributed: $(stable "$1")" >&2
+    fail "counts differ from dicesim toss --threads 1"
+  fi
+}
+# A number from the aggregator's closing health line, e.g. health duplicates agg.err
+health() { grep -oE "$1 [0-9]+" "$2" | tail -n1 | grep -oE '[0-9]+$' || echo 0; }
+# Starts worker number k (1, 2, ...): its log is worker<k>.err, its pid ${wpid[k]}.
+nworkers=0
+declare -a wpid
+worker() { nworkers=$((nworkers + 1)); "$bin" worker --once "$@" 2> "$work/worker$nworkers.err" & wpid[$nworkers]=$!; pids+=($!); }
+aggregate() { "$bin" aggregate "$scene" --tosses "$n" --seed "$seed" --json --timeout 150 "$@" > "$work/out.json" 2> "$work/agg.err"; }
+
+case "$scenario" in
+  three_workers)
+    n=150000
+    reference 1
+    worker; worker; worker
+    aggregate || fail "aggregate exited $?"
+    same_as_reference "$work/out.json"
+    for i in 1 2 3; do grep -qE "ended: finished \([1-9][0-9]* tosses" "$work/worker$i.err" || fail "worker $i did no tosses"; done
+    ;;
+  kill9)
+    n=1000000
+    reference
+    worker; worker; worker
+    aggregate & agg=$!
+    # Mid-run by construction: the kill comes when DICESIM_PROBABILITIES says 10% are in.
+    "$inject" progress 0.1 60 || fail "the run never reached 10%, or finished before the kill"
+    kill -9 "${wpid[1]}"
+    wait "$agg" || fail "aggregate exited $?"
+    same_as_reference "$work/out.json"
+    [ "$(health re-leased "$work/agg.err")" -gt 0 ] || fail "nothing was re-leased after kill -9 (was the victim working?)"
+    ;;
+  drop10)
+    nft add table inet dicesim_test
+    nft add chain inet dicesim_test input '{ type filter hook input priority 0; policy accept; }'
+    nft add rule inet dicesim_test input numgen random mod 10 0 counter drop
+    n=200000
+    reference
+    worker; worker
+    aggregate || fail "aggregate exited $?"
+    same_as_reference "$work/out.json"
+    dropped=$(nft list chain inet dicesim_test input | grep -oE 'packets [0-9]+' | grep -oE '[0-9]+')
+    echo "packets dropped by nftables: $dropped; re-leased tosses: $(health re-leased "$work/agg.err")"
+    [ "$dropped" -gt 0 ] || fail "nftables dropped nothing: the scenario tested nothing"
+    ;;
+  replay)
+    # A worker restarted mid-run, and every batch published so far published again (recorded
+    # with the stock lcm-logger, replayed with lcm-logplayer): nothing may count twice.
+    n=1000000
+    reference
+    lcm-logger -q -f -c DICESIM_TOSS_BATCH "$work/batches.lcmlog" & logger=$!; pids+=($logger)
+    worker; worker
+    aggregate & agg=$!
+    "$inject" progress 0.2 60 || fail "the run never reached 20%, or finished first"
+    kill -9 "${wpid[1]}"
+    worker
+    kill -INT "$logger"; wait "$logger" || true
+    lcm-logplayer -s 20 "$work/batches.lcmlog"
+    wait "$agg" || fail "aggregate exited $?"
+    same_as_reference "$work/out.json"
+    [ "$(health duplicates "$work/agg.err")" -gt 0 ] || fail "no duplicates seen: the replay tested nothing"
+    grep -qE "ended: finished \([1-9][0-9]* tosses" "$work/worker3.err" || fail "the restarted worker did no tosses"
+    ;;
+  late_join)
+    n=600000
+    reference
+    worker
+    aggregate & agg=$!
+    "$inject" progress 0.1 60 || fail "the run never reached 10%, or finished before the late worker"
+    worker
+    wait "$agg" || fail "aggregate exited $?"
+    same_as_reference "$work/out.json"
+    wait "${wpid[2]}" || fail "late worker exited $?"
+    grep -qE "ended: finished \([1-9][0-9]* tosses" "$work/worker2.err" || fail "the late worker did no tosses"
+    ;;
+  hostile)
+    n=200000
+    reference
+    worker; worker
+    aggregate & agg=$!
+    "$inject" hostile > "$work/inject.out" || fail "inject failed"
+    wait "$agg" || fail "aggregate exited $?"
+    same_as_reference "$work/out.json"
+    for k in 1 2; do wait "${wpid[$k]}" || fail "worker $k exited with $? after hostile messages"; done
+    cat "$work/inject.out"; grep -E "batches" "$work/agg.err"
+    [ "$(health foreign "$work/agg.err")" -ge 3 ] || fail "foreign messages not counted"
+    [ "$(health "out of range" "$work/agg.err")" -ge 3 ] || fail "out-of-range batches not counted"
+    [ "$(health malformed "$work/agg.err")" -ge 20 ] || fail "malformed messages not counted"
+    ;;
+  run_cmd)
+    reference
+    url="udpm://239.255.76.67:$((30000 + $$ % 20000))?ttl=0"
+    "$bin" run "$scene" --workers 2 --tosses "$n" --seed "$seed" --json --lcm "$url" > "$work/out.json" 2> "$work/run.err" ||
+      fail "dicesim run exited $?"
+    same_as_reference "$work/out.json"
+    grep -q '"threads":2' "$work/out.json" || fail "threads should report the 2 workers"
+    sleep 0.2
+    if pgrep -f -- "--lcm $url" > /dev/null; then fail "worker processes left behind"; fi
+    ;;
+  interrupt)
+    # Ctrl-C on `dicesim run`: exit 1, no result on stdout, no worker left behind.
+    url="udpm://239.255.76.67:$((30000 + $$ % 20000))?ttl=0"
+    "$bin" run "$scene" --workers 2 --tosses 50000000 --seed "$seed" --json --lcm "$url" > "$work/out.json" 2> "$work/run.err" &
+    run=$!
+    LCM_DEFAULT_URL=$url "$inject" progress 0.0001 60 || fail "the run did not start"
+    kill -INT "$run"
+    code=0
+    wait "$run" || code=$?
+    [ "$code" -eq 1 ] || fail "an interrupted run exited $code, expected 1"
+    [ ! -s "$work/out.json" ] || fail "an interrupted run printed a result"
+    grep -q "interrupted" "$work/run.err" || fail "no 'interrupted' on stderr"
+    sleep 0.2
+    if pgrep -f -- "--lcm $url" > /dev/null; then fail "worker processes left behind"; fi
+    ;;
+  target)
+    n=1000000
+    h=0.004  # about 35 000 tosses: a few blocks of 10 000
+    "$bin" toss "$scene" --seed "$seed" --threads 2 --json --target-halfwidth $h > "$work/ref.json" 2> "$work/ref.err"
+    "$bin" toss "$scene" --seed "$seed" --threads 1 --json --target-halfwidth $h > "$work/ref1.json" 2>/dev/null
+    [ "$(stable "$work/ref.json")" = "$(stable "$work/ref1.json")" ] || fail "toss --target-halfwidth depends on threads"
+    took=$(grep -oE '"tosses":[0-9]+' "$work/ref.json" | grep -oE '[0-9]+')
+    [ "$took" -gt 10000 ] && [ $((took % 10000)) -eq 0 ] || fail "target stop $took is not a later block boundary"
+    "$bin" run "$scene" --workers 2 --seed "$seed" --json --target-halfwidth $h > "$work/out.json" 2> "$work/run.err" ||
+      fail "dicesim run exited $?"
+    same_as_reference "$work/out.json"
+    echo "target half-width $h: $took tosses in toss and in run"
+    grep -q "reached after" "$work/run.err" || fail "run does not report how many tosses the target took"
+    ;;
+  trace)
+    n=3000
+    reference
+    "$inject" count DICESIM_BOUNCE_STATE 120 > "$work/count.out" & counter=$!; pids+=($counter)
+    sleep 0.5
+    worker
+    aggregate --trace-every 100 || fail "aggregate exited $?"
+    same_as_reference "$work/out.json"
+    sleep 0.3
+    kill -TERM "$counter"; wait "$counter" || true
+    traced=$(cat "$work/count.out")
+    echo "bounce_state messages received: $traced"
+    [ "${traced:-0}" -gt 0 ] || fail "no bounce states published with --trace-every"
+    ;;
+  *) echo "unknown scenario $scenario" >&2; exit 2 ;;
+esac
+[ -f "$work/agg.err" ] && grep -h "batches" "$work/agg.err"
+echo "PASS [$scenario]"

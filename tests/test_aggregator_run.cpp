@@ -1,0 +1,230 @@
+// The aggregator and workers end to end over an in-memory bus (no sockets): lost, duplicated and
+// hostile messages, dead workers — and always the counts of run_tosses on one thread.
+#include <gtest/gtest.h>
+
+#include <deque>
+#include <memory>
+#include <random>
+
+#include "aggregator/aggregator.hpp"
+#include "aggregator/target.hpp"
+#include "messages/run_spec.hpp"
+#include "sim/monte_carlo.hpp"
+#include "sim/scene.hpp"
+#include "sim/worker/worker.hpp"
+
+namespace {
+
+using namespace dicesim;
+
+struct Message {
+  std::string channel;
+  std::vector<std::uint8_t> bytes;
+};
+
+// Everyone hears every message (multicast), unless the bus drops or repeats it.
+struct Net {
+  std::deque<Message> queue;
+  std::mt19937_64 rng{99};
+  double drop = 0.0;       // probability a delivery to one listener is lost
+  double duplicate = 0.0;  // probability a toss_batch is delivered twice
+  std::unique_ptr<agg::Aggregator> agg;
+  std::vector<std::unique_ptr<worker::WorkerCore>> workers;
+  std::vector<bool> alive;
+  double now = 0.0;
+  std::vector<Message> all_batches;  // for replays
+
+  auto sender() {
+    return [this](const char* ch, const std::vector<std::uint8_t>& b) { queue.push_back({ch, b}); };
+  }
+  bool lost() { return drop > 0 && std::uniform_real_distribution<>(0, 1)(rng) < drop; }
+  void deliver(const Message& m) {
+    if (!lost()) agg->on_message(m.channel, m.bytes.data(), m.bytes.size(), now);
+    for (std::size_t w = 0; w < workers.size(); ++w)
+      if (alive[w] && !lost()) workers[w]->on_message(m.channel, m.bytes.data(), m.bytes.size(), now);
+  }
+  void add_worker() {
+    worker::WorkerConfig c;
+    c.batch = 100;
+    workers.push_back(std::make_unique<worker::WorkerCore>(c, sender()));
+    alive.push_back(true);
+  }
+  // Advances 10 ms of simulated time: every live worker may compute one batch.
+  void step() {
+    now += 0.01;
+    agg->tick(now);
+    for (std::size_t w = 0; w < workers.size(); ++w)
+      if (alive[w]) workers[w]->tick(now), workers[w]->step(now);
+    while (!queue.empty()) {
+      Message m = std::move(queue.front());
+      queue.pop_front();
+      if (m.channel == wire::kTossBatch) {
+        all_batches.push_back(m);
+        if (duplicate > 0 && std::uniform_real_distribution<>(0, 1)(rng) < duplicate) deliver(m);
+      }
+      deliver(m);
+    }
+  }
+  bool run(int max_steps = 200000) {
+    for (int i = 0; i < max_steps && !agg->finished(); ++i) step();
+    return agg->finished();
+  }
+};
+
+struct Fixture {
+  wire::RunSpec spec;
+  DieModel model;
+  agg::AggregatorConfig cfg;
+  explicit Fixture(std::uint64_t total, std::uint64_t seed = 3, double target = 0.0) {
+    spec.run_id = 1234;
+    spec.origin = DICESIM_SOURCE_DIR "/scenes/paper/die1.toml";
+    spec.files = wire::read_scene_files(spec.origin);
+    spec.seed = seed;
+    spec.total = total;
+    model = wire::compile_spec(spec);
+    spec.fingerprint = wire::model_fingerprint(model);
+    cfg.spec = spec;
+    cfg.labels = model.face_labels;
+    cfg.max_lease = 700;
+    cfg.min_lease = 150;
+    cfg.target_halfwidth = target;
+  }
+  RunCounts reference(std::uint64_t n) const {
+    RunConfig rc;
+    rc.seed = spec.seed;
+    rc.tosses = n;
+    return run_tosses(model, rc);
+  }
+};
+
+Net make_net(const Fixture& f, int workers) {
+  Net net;
+  net.agg = std::make_unique<agg::Aggregator>(f.cfg, net.sender());
+  for (int i = 0; i < workers; ++i) net.add_worker();
+  return net;
+}
+
+TEST(AggregatorRun, ThreeWorkersGiveTheCountsOfOneThread) {
+  Fixture f(4000);
+  Net net = make_net(f, 3);
+  ASSERT_TRUE(net.run());
+  EXPECT_EQ(net.agg->stop(), 4000u);
+  EXPECT_EQ(net.agg->result(), f.reference(4000));
+  EXPECT_EQ(net.agg->health().duplicates, 0u);
+  EXPECT_EQ(net.agg->health().malformed, 0u);
+  for (auto& w : net.workers) EXPECT_GT(w->tosses_done(), 0u) << "every worker takes part";
+}
+
+TEST(AggregatorRun, LossyBusStillGivesIdenticalCounts) {
+  Fixture f(3000);
+  Net net = make_net(f, 2);
+  net.drop = 0.1;
+  ASSERT_TRUE(net.run());
+  EXPECT_EQ(net.agg->result(), f.reference(3000));
+  EXPECT_GT(net.agg->health().released, 0u) << "10% loss must have forced re-leases";
+}
+
+TEST(AggregatorRun, DuplicatesAndReplaysAreNotCountedTwice) {
+  Fixture f(3000);
+  Net net = make_net(f, 2);
+  net.duplicate = 0.3;
+  for (int i = 0; i < 5; ++i) net.step();
+  ASSERT_FALSE(net.agg->finished());
+  // Replay everything published so far, as a restarted worker re-sending old batches would.
+  for (const Message& m : std::vector<Message>(net.all_batches)) net.deliver(m);
+  ASSERT_TRUE(net.run());
+  EXPECT_EQ(net.agg->result(), f.reference(3000));
+  EXPECT_GT(net.agg->health().duplicates, 0u);
+}
+
+TEST(AggregatorRun, DeadWorkersLeasesGoToTheOthers) {
+  Fixture f(12000);
+  Net net = make_net(f, 3);
+  for (int i = 0; i < 10; ++i) net.step();
+  ASSERT_GT(net.workers[0]->tosses_done(), 0u);
+  ASSERT_FALSE(net.agg->finished());
+  net.alive[0] = false;  // kill -9: no more batches, no heartbeats
+  ASSERT_TRUE(net.run());
+  EXPECT_EQ(net.agg->result(), f.reference(12000));
+  EXPECT_GT(net.agg->health().released, 0u);
+}
+
+TEST(AggregatorRun, LateWorkerTakesPart) {
+  Fixture f(8000);
+  Net net = make_net(f, 1);
+  for (int i = 0; i < 20; ++i) net.step();
+  ASSERT_FALSE(net.agg->finished());
+  net.add_worker();
+  ASSERT_TRUE(net.run());
+  EXPECT_EQ(net.agg->result(), f.reference(8000));
+  EXPECT_GT(net.workers[1]->tosses_done(), 0u);
+}
+
+TEST(AggregatorRun, TargetStopsAtTheSameBlockAsInOrderTossing) {
+  const double h = 0.02;
+  Fixture f(200000, 5, h);
+  Net net = make_net(f, 2);
+  ASSERT_TRUE(net.run());
+  // In order, block by block, as `dicesim toss --target-halfwidth` does.
+  RunCounts c;
+  std::uint64_t done = 0;
+  while (!agg::halfwidth_reached(c, h)) {
+    RunConfig rc;
+    rc.seed = 5;
+    rc.first = done;
+    rc.tosses = agg::kTargetBlock;
+    c.merge(run_tosses(f.model, rc));
+    done += agg::kTargetBlock;
+  }
+  EXPECT_EQ(net.agg->stop(), done);
+  EXPECT_EQ(net.agg->result(), c);
+  EXPECT_LT(done, 200000u);
+}
+
+// Hostile input straight into the handlers: counted, never counted as tosses, never a crash.
+TEST(AggregatorRun, ForeignAndMalformedBatchesAreCountedAndIgnored) {
+  Fixture f(2000);
+  Net net = make_net(f, 1);
+  auto batch = [](std::int64_t run, std::int64_t first, int n, int face, int status) {
+    dicesim_lcm::toss_batch b{};
+    b.run_id = run, b.worker_id = 1, b.lease_id = 1, b.first_index = first, b.count = n;
+    b.faces.assign(static_cast<std::size_t>(n), static_cast<std::int8_t>(face));
+    b.statuses.assign(static_cast<std::size_t>(n), static_cast<std::int8_t>(status));
+    b.bounces.assign(static_cast<std::size_t>(n), 2);
+    return wire::encode(b);
+  };
+  auto feed = [&](const std::vector<std::uint8_t>& b) { net.agg->on_message(wire::kTossBatch, b.data(), b.size(), 0.0); };
+  feed(batch(999, 0, 10, 1, 0));    // foreign
+  feed(batch(1234, 1995, 10, 1, 0));  // past the end
+  feed(batch(1234, -1, 10, 1, 0));  // negative
+  feed(batch(1234, 0, 10, 7, 0));   // face 7
+  feed(batch(1234, 0, 10, 0, 0));   // settled on face 0
+  feed(batch(1234, 0, 10, 3, 2));   // invalid toss with a face
+  feed(batch(1234, 0, 10, 0, 5));   // status 5
+  auto good = batch(1234, 0, 10, 1, 0);
+  feed(std::vector<std::uint8_t>(good.begin(), good.end() - 1));  // truncated
+  good.push_back(0);
+  feed(good);  // trailing byte
+  good.pop_back();
+  good[51] = 0x7f;  // count far beyond the payload
+  feed(good);
+  const auto& h = net.agg->health();
+  EXPECT_EQ(h.foreign, 1u);
+  EXPECT_EQ(h.range, 2u);
+  EXPECT_EQ(h.malformed, 7u);
+  EXPECT_EQ(net.agg->received(), 0u);
+  ASSERT_TRUE(net.run());
+  EXPECT_EQ(net.agg->result(), f.reference(2000));
+}
+
+TEST(AggregatorRun, WorkerRefusesAModelItCannotRebuild) {
+  Fixture f(1000);
+  f.cfg.spec.fingerprint ^= 1;  // as if the aggregator ran another build
+  Net net = make_net(f, 1);
+  for (int i = 0; i < 50; ++i) net.step();
+  ASSERT_EQ(net.agg->refusals().size(), 1u);
+  EXPECT_NE(net.agg->refusals()[0].find("fingerprint"), std::string::npos) << net.agg->refusals()[0];
+  EXPECT_EQ(net.agg->received(), 0u);
+}
+
+}  // namespace
