@@ -23,6 +23,26 @@ SceneDef SceneArgs::load() const {
   return load_scene(path, all);
 }
 
+int parse_and_run(CLI::App& app, int argc, char** argv, const int& exit_code) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "%s: %s\nRun with --help for usage.\n", app.get_name().c_str(), e.what());
+    return kExitBadInput;
+  } catch (const SceneError& e) {
+    std::fprintf(stderr, "dicesim: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dicesim: failed: %s\n", e.what());
+    return kExitFailed;
+  }
+  return exit_code;
+}
+
 int run_cli(int argc, char** argv) {
   // `dicesim bench tradeoff SCENE` lives next to `dicesim bench SCENE` (whose SCENE is positional).
   if (argc >= 3 && std::string_view(argv[1]) == "bench" && std::string_view(argv[2]) == "tradeoff")
@@ -48,23 +68,7 @@ int run_cli(int argc, char** argv) {
   register_worker(app, exit_code);
   register_aggregate(app, exit_code);
   register_run(app, exit_code);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "dicesim: %s\nRun with --help for usage.\n", e.what());
-    return kExitBadInput;
-  } catch (const SceneError& e) {
-    std::fprintf(stderr, "dicesim: error: %s\n", e.what());
-    return kExitBadInput;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "dicesim: failed: %s\n", e.what());
-    return kExitFailed;
-  }
-  return exit_code;
+  return parse_and_run(app, argc, argv, exit_code);
 }
 
 }  // namespace dicesim

@@ -224,21 +224,7 @@ int run_bench_tradeoff(int argc, char** argv) {
   app.add_option("--plot", a->plot, "Also draw accuracy against speed as PNG (gnuplot)")->type_name("FILE.png");
   int exit_code = kExitOk;
   app.callback([a, &exit_code] { exit_code = run_tradeoff(*a); });
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "dicesim bench tradeoff: %s\nRun with --help for usage.\n", e.what());
-    return kExitBadInput;
-  } catch (const SceneError& e) {
-    std::fprintf(stderr, "dicesim: error: %s\n", e.what());
-    return kExitBadInput;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "dicesim: failed: %s\n", e.what());
-    return kExitFailed;
-  }
-  return exit_code;
+  return parse_and_run(app, argc, argv, exit_code);
 }
 
 }  // namespace dicesim

@@ -55,6 +55,10 @@ struct AggregateArgs {
 int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::int64_t run_id, int workers,
                          const std::function<std::string()>& on_tick, const std::atomic<bool>* cancel);
 
+// Parses argv into `app` and runs the chosen callback (which sets exit_code); maps errors to exit
+// codes: help 0, bad usage or SceneError 2 (message on stderr, nothing on stdout), others 1.
+int parse_and_run(CLI::App& app, int argc, char** argv, const int& exit_code);
+
 // Runs the command line; returns the process exit code. main() only calls this.
 int run_cli(int argc, char** argv);
 

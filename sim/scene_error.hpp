@@ -11,7 +11,7 @@ class SceneError : public std::runtime_error {
   // file: the scene file (or "--set"); key: dotted key path; value: what was given;
   // allowed: the allowed range or form, in words.
   SceneError(std::string file, std::string key, std::string value, std::string allowed)
-      : std::runtime_error(file + ": " + key + (value.empty() ? "" : " = " + value) + ": " + allowed),
+      : std::runtime_error(file + ": " + (key.empty() ? "" : key + (value.empty() ? "" : " = " + value) + ": ") + allowed),
         file_(std::move(file)), key_(std::move(key)), value_(std::move(value)), allowed_(std::move(allowed)) {}
 
   const std::string& file() const { return file_; }

@@ -1,6 +1,8 @@
 // The `dicesim` command line as a user meets it: output formats, exit codes, error messages.
 #include <gtest/gtest.h>
 
+#include "cli_runner.hpp"
+
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -12,40 +14,15 @@
 
 namespace {
 
-struct CliRun {
-  int code = -1;
-  std::string out, err;
-};
+using dicesim::testing::CliRun;
+using dicesim::testing::expect_bad_input;
 
-CliRun dicesim(const std::string& args) {
-  // One stderr file per test: CTest runs tests in parallel processes.
-  const std::string err_file = ::testing::TempDir() + "dicesim_cli_stderr_" +
-                               ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".txt";
-  const std::string cmd = std::string("cd ") + DICESIM_SOURCE_DIR + " && " + DICESIM_BINARY + " " + args + " 2>" + err_file;
-  CliRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream e(err_file);
-  std::stringstream ss;
-  ss << e.rdbuf();
-  r.err = ss.str();
-  return r;
-}
-
-void expect_bad_input(const CliRun& r, std::initializer_list<const char*> mentions) {
-  EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_TRUE(r.out.empty()) << "stdout must stay empty on bad input: " << r.out;
-  for (const char* m : mentions) EXPECT_NE(r.err.find(m), std::string::npos) << "stderr lacks '" << m << "': " << r.err;
-}
+CliRun cli(const std::string& args) { return dicesim::testing::run_dicesim(args); }
 
 }  // namespace
 
 TEST(Cli, TossJsonIsOneObjectWithEveryKey) {
-  const CliRun r = dicesim("toss scenes/paper/die1.toml --tosses 3000 --seed 5 --threads 2 --json");
+  const CliRun r = cli("toss scenes/paper/die1.toml --tosses 3000 --seed 5 --threads 2 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);  // throws if there is anything but one object
   for (const char* k : {"scene", "fidelity", "seed", "threads", "tosses", "settled", "unresolved", "invalid", "faces",
@@ -70,7 +47,7 @@ TEST(Cli, TossJsonIsOneObjectWithEveryKey) {
 
 TEST(Cli, CountsDoNotDependOnThreads) {
   const auto counts = [](const std::string& threads) {
-    const CliRun r = dicesim("toss scenes/paper/die2.toml --tosses 5000 --seed 9 --json --threads " + threads);
+    const CliRun r = cli("toss scenes/paper/die2.toml --tosses 5000 --seed 9 --json --threads " + threads);
     EXPECT_EQ(r.code, 0) << r.err;
     return nlohmann::json::parse(r.out)["faces"].dump();
   };
@@ -78,14 +55,14 @@ TEST(Cli, CountsDoNotDependOnThreads) {
 }
 
 TEST(Cli, TableIsReadable) {
-  const CliRun r = dicesim("toss scenes/fair.toml --tosses 1000");
+  const CliRun r = cli("toss scenes/fair.toml --tosses 1000");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("95% interval"), std::string::npos);
   EXPECT_NE(r.out.find("settled"), std::string::npos);
 }
 
 TEST(Cli, InfoJsonHasMassProperties) {
-  const CliRun r = dicesim("info scenes/paper/die3.toml --json");
+  const CliRun r = cli("info scenes/paper/die3.toml --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_GT(j["mass"].get<double>(), 0.0);
@@ -97,37 +74,37 @@ TEST(Cli, InfoJsonHasMassProperties) {
 }
 
 TEST(Cli, HelpTeaches) {
-  const CliRun r = dicesim("toss --help");
+  const CliRun r = cli("toss --help");
   EXPECT_EQ(r.code, 0);
   EXPECT_NE(r.out.find("--tosses"), std::string::npos);
   EXPECT_NE(r.out.find("--set"), std::string::npos);
   EXPECT_NE(r.out.find("Example"), std::string::npos);
 }
 
-TEST(Cli, MissingFile) { expect_bad_input(dicesim("toss scenes/nope.toml"), {"scenes/nope.toml"}); }
+TEST(Cli, MissingFile) { expect_bad_input(cli("toss scenes/nope.toml"), {"scenes/nope.toml"}); }
 
 TEST(Cli, UnknownKey) {
-  expect_bad_input(dicesim("toss scenes/paper/die1.toml --set materials.steel.densty=1"), {"densty"});
+  expect_bad_input(cli("toss scenes/paper/die1.toml --set materials.steel.densty=1"), {"densty"});
 }
 
 TEST(Cli, NegativeDensity) {
-  expect_bad_input(dicesim("toss scenes/paper/die1.toml --set materials.steel.density=-5"),
+  expect_bad_input(cli("toss scenes/paper/die1.toml --set materials.steel.density=-5"),
                    {"die1.toml", "materials.steel.density", "-5"});
 }
 
 TEST(Cli, RestitutionOutOfRange) {
-  expect_bad_input(dicesim("toss scenes/paper/die1.toml --set materials.aluminium.restitution=1.5"),
+  expect_bad_input(cli("toss scenes/paper/die1.toml --set materials.aluminium.restitution=1.5"),
                    {"materials.aluminium.restitution", "1.5"});
 }
 
-TEST(Cli, NotANumber) { expect_bad_input(dicesim("toss scenes/paper/die1.toml --set throw.height.mean=nan"), {"throw.height.mean"}); }
+TEST(Cli, NotANumber) { expect_bad_input(cli("toss scenes/paper/die1.toml --set throw.height.mean=nan"), {"throw.height.mean"}); }
 
-TEST(Cli, WrongType) { expect_bad_input(dicesim("toss scenes/paper/die1.toml --set sim.stop_speed='\"fast\"'"), {"sim.stop_speed"}); }
+TEST(Cli, WrongType) { expect_bad_input(cli("toss scenes/paper/die1.toml --set sim.stop_speed='\"fast\"'"), {"sim.stop_speed"}); }
 
 TEST(Cli, DieBelowTheFloor) {
-  expect_bad_input(dicesim("toss scenes/paper/die1.toml --set throw.height.mean=0.001"), {"throw.height.mean", "floor"});
+  expect_bad_input(cli("toss scenes/paper/die1.toml --set throw.height.mean=0.001"), {"throw.height.mean", "floor"});
 }
 
-TEST(Cli, UnknownFidelity) { expect_bad_input(dicesim("toss scenes/paper/die1.toml --fidelity warp"), {"warp"}); }
+TEST(Cli, UnknownFidelity) { expect_bad_input(cli("toss scenes/paper/die1.toml --fidelity warp"), {"warp"}); }
 
-TEST(Cli, BadOption) { expect_bad_input(dicesim("toss scenes/paper/die1.toml --tosses -3"), {}); }
+TEST(Cli, BadOption) { expect_bad_input(cli("toss scenes/paper/die1.toml --tosses -3"), {}); }

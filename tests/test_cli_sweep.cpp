@@ -2,6 +2,8 @@
 // codes, error messages, plots.
 #include <gtest/gtest.h>
 
+#include "cli_runner.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -18,44 +20,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int code = -1;
-  std::string out, err;
-};
+using dicesim::testing::CliRun;
+using dicesim::testing::expect_bad_input;
 
-// CTest runs tests as parallel processes: every file a test writes carries its name and pid.
-std::string unique(const std::string& name) {
-  return ::testing::TempDir() + "dicesim_" + ::testing::UnitTest::GetInstance()->current_test_info()->test_suite_name() +
-         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" + std::to_string(::getpid()) + "_" + name;
-}
-
-CliRun dicesim(const std::string& args) {
-  const std::string err_file = unique("stderr.txt");
-  const std::string cmd = std::string("cd ") + DICESIM_SOURCE_DIR + " && " + DICESIM_BINARY + " " + args + " 2>" + err_file;
-  CliRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream e(err_file);
-  std::stringstream ss;
-  ss << e.rdbuf();
-  r.err = ss.str();
-  return r;
-}
-
-void expect_bad_input(const CliRun& r, std::initializer_list<const char*> mentions) {
-  EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_TRUE(r.out.empty()) << "stdout must stay empty on bad input: " << r.out;
-  for (const char* m : mentions) EXPECT_NE(r.err.find(m), std::string::npos) << "stderr lacks '" << m << "': " << r.err;
-}
-
-std::string tmp(const std::string& name) { return unique(name); }
+CliRun cli(const std::string& args) { return dicesim::testing::run_dicesim(args); }
+std::string tmp(const std::string& name) { return dicesim::testing::unique_temp(name); }
 
 TEST(CliSweep, JsonHasEveryPointAndFace) {
-  const CliRun r = dicesim("sweep scenes/paper/die1.toml --param floor.restitution --values 0.2,0.8 -n 400 --seed 3 --json");
+  const CliRun r = cli("sweep scenes/paper/die1.toml --param floor.restitution --values 0.2,0.8 -n 400 --seed 3 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["param"], "floor.restitution");
@@ -76,7 +48,7 @@ TEST(CliSweep, JsonHasEveryPointAndFace) {
 }
 
 TEST(CliSweep, CsvColumnsAndVectorTemplate) {
-  const CliRun r = dicesim("sweep scenes/paper/die1.toml --param throw.velocity.mean --template '[{}, 0, 0]' "
+  const CliRun r = cli("sweep scenes/paper/die1.toml --param throw.velocity.mean --template '[{}, 0, 0]' "
                            "--values 1:3:1 -n 300 --csv -");
   ASSERT_EQ(r.code, 0) << r.err;
   std::istringstream in(r.out);
@@ -102,7 +74,7 @@ TEST(CliSweep, SweepFileWithPlotAndMarkdown) {
   const std::string png = tmp("orientation.png"), md = tmp("orientation.md");
   fs::remove(png);
   fs::remove(md);
-  const CliRun r = dicesim("sweep scenes/paper/sweeps/initial-orientation.toml -n 300 --plot " + png + " --markdown " + md);
+  const CliRun r = cli("sweep scenes/paper/sweeps/initial-orientation.toml -n 300 --plot " + png + " --markdown " + md);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("6 (aluminium)"), std::string::npos) << r.out;
   ASSERT_TRUE(fs::exists(png));
@@ -122,7 +94,7 @@ TEST(CliSweep, SweepFileWithPlotAndMarkdown) {
 TEST(CliSweep, SvgPlot) {
   const std::string svg = tmp("h.svg");
   fs::remove(svg);
-  const CliRun r = dicesim("sweep scenes/paper/die1.toml --param throw.height.mean --values 0.5,1 -n 200 --plot " + svg);
+  const CliRun r = cli("sweep scenes/paper/die1.toml --param throw.height.mean --values 0.5,1 -n 200 --plot " + svg);
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(svg);
   std::stringstream ss;
@@ -131,22 +103,22 @@ TEST(CliSweep, SvgPlot) {
 }
 
 TEST(CliSweep, BadInput) {
-  expect_bad_input(dicesim("sweep scenes/paper/die1.toml --param floor.restitution --values 1:2:0"), {"--values", "1:2:0", "step"});
-  expect_bad_input(dicesim("sweep scenes/paper/die1.toml --param floor.restitution --values 0.5,1.5"),
+  expect_bad_input(cli("sweep scenes/paper/die1.toml --param floor.restitution --values 1:2:0"), {"--values", "1:2:0", "step"});
+  expect_bad_input(cli("sweep scenes/paper/die1.toml --param floor.restitution --values 0.5,1.5"),
                    {"floor.restitution", "1.5", "[0, 1]"});
-  expect_bad_input(dicesim("sweep scenes/paper/die1.toml --param floor.restitutoin --values 0.5"), {"restitutoin", "unknown key"});
-  expect_bad_input(dicesim("sweep scenes/paper/die1.toml"), {"--param", "sweep file"});
-  expect_bad_input(dicesim("sweep scenes/paper/die1.toml --param floor.restitution --values 0.5 --plot x.gif"), {"--plot", ".png"});
-  expect_bad_input(dicesim("sweep scenes/paper/sweeps/height.toml --param floor.restitution --values 0.5"), {"height.toml", "sweep file"});
-  expect_bad_input(dicesim("sweep no/such.toml --param a --values 1"), {"no/such.toml", "cannot open"});
-  expect_bad_input(dicesim("sweep no/such.toml"), {"no/such.toml", "cannot open"});
-  expect_bad_input(dicesim("sweep scenes/paper/die1.toml --param floor.restitution --values 0.5 --json --csv -"), {"--csv", "--json"});
-  expect_bad_input(dicesim("sweep scenes/paper/die1.toml --param throw.velocity.mean --template '[1, 2]' --values 1"), {"--template", "{}"});
+  expect_bad_input(cli("sweep scenes/paper/die1.toml --param floor.restitutoin --values 0.5"), {"restitutoin", "unknown key"});
+  expect_bad_input(cli("sweep scenes/paper/die1.toml"), {"--param", "sweep file"});
+  expect_bad_input(cli("sweep scenes/paper/die1.toml --param floor.restitution --values 0.5 --plot x.gif"), {"--plot", ".png"});
+  expect_bad_input(cli("sweep scenes/paper/sweeps/height.toml --param floor.restitution --values 0.5"), {"height.toml", "sweep file"});
+  expect_bad_input(cli("sweep no/such.toml --param a --values 1"), {"no/such.toml", "cannot open"});
+  expect_bad_input(cli("sweep no/such.toml"), {"no/such.toml", "cannot open"});
+  expect_bad_input(cli("sweep scenes/paper/die1.toml --param floor.restitution --values 0.5 --json --csv -"), {"--csv", "--json"});
+  expect_bad_input(cli("sweep scenes/paper/die1.toml --param throw.velocity.mean --template '[1, 2]' --values 1"), {"--template", "{}"});
 }
 
 TEST(CliSweep, HelpTeachesWithExamples) {
   for (const char* cmd : {"sweep", "calibrate-restitution", "compare"}) {
-    const CliRun r = dicesim(std::string(cmd) + " --help");
+    const CliRun r = cli(std::string(cmd) + " --help");
     EXPECT_EQ(r.code, 0) << cmd;
     EXPECT_NE(r.out.find("Examples:"), std::string::npos) << cmd;
   }
@@ -155,7 +127,7 @@ TEST(CliSweep, HelpTeachesWithExamples) {
 TEST(CliCalibrate, SeedTables4And5) {
   const std::string csv = "data/seed-tables/table04_05_restitution_trials.csv";
   for (const auto& [material, expected] : {std::pair{"steel", 0.487}, std::pair{"aluminium", 0.550}}) {
-    const CliRun r = dicesim("calibrate-restitution --pairs " + csv + " --where material=" + material + " --json");
+    const CliRun r = cli("calibrate-restitution --pairs " + csv + " --where material=" + material + " --json");
     ASSERT_EQ(r.code, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_NEAR(j["restitution"].get<double>(), expected, 0.0005) << material;
@@ -163,7 +135,7 @@ TEST(CliCalibrate, SeedTables4And5) {
     EXPECT_LT(j["ci95"][0].get<double>(), expected);
     EXPECT_GT(j["ci95"][1].get<double>(), expected);
   }
-  const CliRun table = dicesim("calibrate-restitution --pairs " + csv + " --where material=steel");
+  const CliRun table = cli("calibrate-restitution --pairs " + csv + " --where material=steel");
   EXPECT_EQ(table.code, 0);
   EXPECT_NE(table.out.find("restitution 0.4869"), std::string::npos) << table.out;
 }
@@ -184,7 +156,7 @@ TEST(CliCalibrate, Track) {
       out << t << "," << z << "\n";
     }
   }
-  const CliRun r = dicesim("calibrate-restitution --track " + path + " --json");
+  const CliRun r = cli("calibrate-restitution --track " + path + " --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_NEAR(j["restitution"].get<double>(), 0.5, 1e-3);
@@ -194,20 +166,20 @@ TEST(CliCalibrate, Track) {
 
 TEST(CliCalibrate, BadInput) {
   const std::string csv = "data/seed-tables/table04_05_restitution_trials.csv";
-  expect_bad_input(dicesim("calibrate-restitution"), {"--pairs", "--track"});
-  expect_bad_input(dicesim("calibrate-restitution --pairs " + csv + " --where material=gold"), {"need at least 2"});
-  expect_bad_input(dicesim("calibrate-restitution --pairs " + csv + " --where colour=red"), {"colour", "not found"});
-  expect_bad_input(dicesim("calibrate-restitution --track " + csv), {"column t", "not found", "v_in_m_s"});
+  expect_bad_input(cli("calibrate-restitution"), {"--pairs", "--track"});
+  expect_bad_input(cli("calibrate-restitution --pairs " + csv + " --where material=gold"), {"need at least 2"});
+  expect_bad_input(cli("calibrate-restitution --pairs " + csv + " --where colour=red"), {"colour", "not found"});
+  expect_bad_input(cli("calibrate-restitution --track " + csv), {"column t", "not found", "v_in_m_s"});
   const std::string bad = tmp("bad_pairs.csv");
   std::ofstream(bad) << "v_in,v_out\n6.1,3.0\n6.2,fast\n";
-  expect_bad_input(dicesim("calibrate-restitution --pairs " + bad), {"line 3", "v_out", "'fast'", "finite number"});
+  expect_bad_input(cli("calibrate-restitution --pairs " + bad), {"line 3", "v_out", "'fast'", "finite number"});
 }
 
 TEST(CliCompare, RunAgainstTheSeedsExperiment) {
   const std::string sim = tmp("die1_sim.json");
-  const CliRun toss = dicesim("toss scenes/paper/die1.toml -n 2000 --json > " + sim);
+  const CliRun toss = cli("toss scenes/paper/die1.toml -n 2000 --json > " + sim);
   ASSERT_EQ(toss.code, 0) << toss.err;
-  const CliRun r = dicesim("compare " + sim + " data/seed-experiments/die1_counts.csv --json");
+  const CliRun r = cli("compare " + sim + " data/seed-experiments/die1_counts.csv --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["n_a"], 2000);
@@ -216,21 +188,21 @@ TEST(CliCompare, RunAgainstTheSeedsExperiment) {
   ASSERT_EQ(j["faces"].size(), 6u);
   EXPECT_EQ(j["faces"][5]["count_b"], 135);
   // Against itself: no difference at all.
-  const CliRun self = dicesim("compare " + sim + " " + sim + " --json");
+  const CliRun self = cli("compare " + sim + " " + sim + " --json");
   ASSERT_EQ(self.code, 0);
   EXPECT_NEAR(nlohmann::json::parse(self.out)["chi2"]["statistic"].get<double>(), 0.0, 1e-9);
-  const CliRun table = dicesim("compare " + sim + " data/seed-experiments/die1_counts.csv");
+  const CliRun table = cli("compare " + sim + " data/seed-experiments/die1_counts.csv");
   EXPECT_NE(table.out.find("chi-square homogeneity"), std::string::npos) << table.out;
 }
 
 TEST(CliCompare, BadInput) {
   const std::string bad = tmp("bad_counts.csv");
   std::ofstream(bad) << "face,count\n1,10\n2,-3\n";
-  expect_bad_input(dicesim("compare data/seed-experiments/die1_counts.csv " + bad), {"bad_counts.csv", "line 3", "count"});
+  expect_bad_input(cli("compare data/seed-experiments/die1_counts.csv " + bad), {"bad_counts.csv", "line 3", "count"});
   const std::string five = tmp("five_faces.csv");
   std::ofstream(five) << "1,10\n2,10\n3,10\n4,10\n5,10\n7,10\n";
-  expect_bad_input(dicesim("compare data/seed-experiments/die1_counts.csv " + five), {"different face labels"});
-  expect_bad_input(dicesim("compare nope.json data/seed-experiments/die1_counts.csv"), {"nope.json", "cannot open"});
+  expect_bad_input(cli("compare data/seed-experiments/die1_counts.csv " + five), {"different face labels"});
+  expect_bad_input(cli("compare nope.json data/seed-experiments/die1_counts.csv"), {"nope.json", "cannot open"});
 }
 
 }  // namespace
