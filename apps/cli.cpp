@@ -24,6 +24,7 @@ SceneDef SceneArgs::load() const {
 }
 
 int parse_and_run(CLI::App& app, int argc, char** argv, const int& exit_code) {
+  add_log_options(app, argc, argv);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -68,6 +69,10 @@ int run_cli(int argc, char** argv) {
   register_worker(app, exit_code);
   register_aggregate(app, exit_code);
   register_run(app, exit_code);
+  register_bridge(app, exit_code);
+  register_watch(app, exit_code);
+  register_record(app, exit_code);
+  register_replay(app, exit_code);
   return parse_and_run(app, argc, argv, exit_code);
 }
 

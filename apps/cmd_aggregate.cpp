@@ -3,13 +3,15 @@
 #include <algorithm>
 #include <csignal>
 #include <cstdio>
-#include <random>
+
+#include <spdlog/spdlog.h>
 
 #include "aggregator/session.hpp"
 #include "aggregator/target.hpp"
 #include "apps/commands.hpp"
 #include "apps/progress.hpp"
 #include "apps/report.hpp"
+#include "logger/log.hpp"
 #include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
 #include "sim/die_model.hpp"
@@ -22,13 +24,6 @@ void on_stop_signal(int) { g_stop = true; }
 
 // With a target and no explicit --tosses, the run may go this far.
 constexpr std::uint64_t kTargetCap = 1'000'000'000;
-
-std::int64_t new_run_id() {
-  std::random_device rd;
-  std::uint64_t v = 0;
-  while (v == 0) v = ((std::uint64_t{rd()} << 32) ^ rd()) & INT64_MAX;
-  return static_cast<std::int64_t>(v);
-}
 
 }  // namespace
 
@@ -65,24 +60,13 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   if (!a.scene.fidelity.empty()) overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
 
   agg::AggregatorConfig cfg;
-  wire::RunSpec& spec = cfg.spec;
-  spec.run_id = run_id != 0 ? run_id : new_run_id();
-  spec.origin = a.scene.path;
-  spec.files = wire::read_scene_files(a.scene.path);
-  spec.overrides = overrides;
-  spec.fidelity = to_string(model.fidelity);
-  spec.seed = a.seed;
-  spec.total = a.target_halfwidth > 0 && a.tosses_opt && a.tosses_opt->count() == 0 ? kTargetCap : a.tosses;
-  spec.trace_every = a.trace_every;
-  spec.fingerprint = wire::model_fingerprint(model);
-  spec.hash = wire::scene_hash(spec.files, overrides);
+  const std::uint64_t total = a.target_halfwidth > 0 && a.tosses_opt && a.tosses_opt->count() == 0 ? kTargetCap : a.tosses;
+  cfg.spec = wire::make_run_spec(run_id != 0 ? run_id : wire::new_run_id(), a.scene.path, overrides, model, a.seed, total,
+                                 a.trace_every);
+  const wire::RunSpec& spec = cfg.spec;
+  logging::set_run_id(spec.run_id);
   cfg.labels = model.face_labels;
   cfg.target_halfwidth = a.target_halfwidth;
-  // What a worker will do with run_start, done here first: a run no worker could rebuild fails now.
-  if (wire::model_fingerprint(wire::compile_spec(spec)) != spec.fingerprint) {
-    std::fprintf(stderr, "dicesim: failed: the scene does not rebuild identically from its files (run_start)\n");
-    return kExitFailed;
-  }
 
   ProgressBar bar;
   std::size_t refusals_shown = 0;
@@ -97,15 +81,14 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
     bar.update(agg.received(), agg.total());
     most_workers = std::max(most_workers, agg.live_workers());
     for (; refusals_shown < agg.refusals().size(); ++refusals_shown)
-      std::fprintf(stderr, "dicesim: warning: %s\n", agg.refusals()[refusals_shown].c_str());
+      spdlog::warn("{}", agg.refusals()[refusals_shown]);
     if (agg.live_workers() > 0) {
       idle_since = -1.0;
     } else if (idle_since < 0) {
       idle_since = now;
     } else if (workers == 0 && now - idle_since > 5.0 && now - last_hint > 30.0) {
       last_hint = now;
-      std::fprintf(stderr, "dicesim: waiting for workers on %s (start some: dicesim worker --lcm '%s')\n", url.c_str(),
-                   url.c_str());
+      spdlog::info("waiting for workers on {} (start some: dicesim worker --lcm '{}')", url, url);
     }
     if (a.timeout_s > 0 && now > a.timeout_s)
       return "timed out after " + std::to_string(a.timeout_s) + " s with " + std::to_string(agg.received()) + " of " +
@@ -114,8 +97,8 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   };
   const agg::SessionResult res = agg::run_session(opt, cfg);
   bar.finish();
-  std::fprintf(stderr, "dicesim: run %lld: %s\n", static_cast<long long>(spec.run_id),
-               agg::health_line(res.health).c_str());
+  // The health line (tests/integration greps it) is a log line: info, with the run's context.
+  spdlog::info("run {}: {}", spec.run_id, agg::health_line(res.health));
   if (res.end == agg::SessionEnd::Cancelled) {
     std::fprintf(stderr, "dicesim: interrupted\n");
     return kExitFailed;

@@ -2,7 +2,9 @@
 // JSON, a gnuplot picture with 95% bands, and (for sweep files that name a seed table) a
 // Markdown table beside the seed's numbers.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -15,6 +17,8 @@
 
 #include "apps/commands.hpp"
 #include "apps/progress.hpp"
+#include "apps/sweep_workers.hpp"
+#include "messages/wire.hpp"
 #include "sim/compare.hpp"
 #include "sim/scene_error.hpp"
 #include "sim/sweep.hpp"
@@ -36,9 +40,15 @@ struct SweepArgs {
   CLI::Option* shift_opt = nullptr;
   CLI::Option* template_opt = nullptr;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  int workers = 0;           // > 0: each point is a distributed run with this many local worker processes
+  std::string lcm;           // the bus for distributed points (default: a private host-confined URL)
   bool json = false;
   std::string csv, plot, markdown;
+  bool distributed() const { return workers > 0 || !lcm.empty(); }
 };
+
+std::atomic<bool> g_stop{false};
+void on_stop_signal(int) { g_stop = true; }
 
 // A point compared with the seed's row at the same x.
 struct SeedMatch {
@@ -184,7 +194,7 @@ std::string csv_text(const SweepResult& res) {
 }
 
 nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const std::vector<ReferenceRow>& seed_rows,
-                           int threads) {
+                           int threads, int workers) {
   nlohmann::json points = nlohmann::json::array();
   int compared = 0, rejected = 0;
   std::uint64_t tosses = 0;
@@ -220,6 +230,7 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
                       {"seed", spec.seed},
                       {"tosses", spec.tosses},
                       {"threads", threads},
+                      {"workers", workers},
                       {"points", points},
                       {"elapsed_s", res.elapsed_s},
                       {"tosses_per_s", res.elapsed_s > 0 ? static_cast<double>(tosses) / res.elapsed_s : 0.0}};
@@ -232,11 +243,12 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
   return j;
 }
 
-std::string table_text(const SweepSpec& spec, const SweepResult& res, int threads) {
+std::string table_text(const SweepSpec& spec, const SweepResult& res, int threads, int workers) {
   std::ostringstream out;
   out << spec.title << "  (" << spec.scene << ", fidelity " << (res.points.empty() ? "" : res.points[0].fidelity)
-      << ", seed " << spec.seed << ", " << spec.tosses << " tosses per point, " << threads << " thread"
-      << (threads == 1 ? "" : "s") << ")\n\n";
+      << ", seed " << spec.seed << ", " << spec.tosses << " tosses per point, ";
+  if (workers > 0) out << workers << " worker process" << (workers == 1 ? "" : "es") << ")\n\n";
+  else out << threads << " thread" << (threads == 1 ? "" : "s") << ")\n\n";
   const auto first = res.points.empty() ? std::array<FaceEstimate, 6>{} : face_estimates(res.points[0].counts, res.points[0].labels);
   char line[512];
   std::snprintf(line, sizeof line, "%-14s", spec.x_label.size() <= 14 ? spec.x_label.c_str() : "x");
@@ -357,8 +369,23 @@ int run_sweep_cmd(const SweepArgs& a) {
   SweepRunOptions opt;
   opt.threads = a.threads;
   opt.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
+  std::unique_ptr<SweepOverLcm> lcm;
+  if (a.distributed()) {
+    std::string url = wire::resolve_url(a.lcm);
+    if (a.lcm.empty() && url == wire::kDefaultUrl) url = private_lcm_url();
+    std::signal(SIGINT, on_stop_signal);
+    std::signal(SIGTERM, on_stop_signal);
+    lcm = std::make_unique<SweepOverLcm>(spec.scene, url, a.workers, &g_stop);
+    opt.run_point = lcm->runner();
+    opt.cancel = &g_stop;
+  }
   const SweepResult res = run_sweep(spec, opt);
   bar.finish();
+  lcm.reset();  // stops the local workers
+  if (g_stop) {
+    std::fprintf(stderr, "dicesim: interrupted\n");
+    return kExitFailed;
+  }
 
   if (!a.csv.empty()) {
     if (a.csv == "-") std::fputs(csv_text(res).c_str(), stdout);
@@ -367,9 +394,9 @@ int run_sweep_cmd(const SweepArgs& a) {
   if (!a.markdown.empty()) write_text(a.markdown, markdown_text(spec, res, seed_rows));
   if (!a.plot.empty()) write_plot(a.plot, spec, res, seed_rows);
   if (a.json)
-    std::printf("%s\n", json_report(spec, res, seed_rows, a.threads).dump().c_str());
+    std::printf("%s\n", json_report(spec, res, seed_rows, a.threads, a.workers).dump().c_str());
   else if (a.csv != "-")
-    std::fputs(table_text(spec, res, a.threads).c_str(), stdout);
+    std::fputs(table_text(spec, res, a.threads, a.workers).c_str(), stdout);
   return kExitOk;
 }
 
@@ -388,7 +415,8 @@ void register_sweep(CLI::App& app, int& exit_code) {
       "  dicesim sweep scenes/paper/die1.toml --param floor.restitution --values 0.1,0.5,0.9 -n 20000 --json\n"
       "  dicesim sweep scenes/paper/die1.toml --param throw.velocity.mean --template '[{}, 0, 0]' \\\n"
       "      --values 0.5:15:0.5 --csv vx.csv --plot vx.png\n"
-      "  dicesim sweep scenes/paper/sweeps/volume-ratio.toml --plot ratio.png --markdown ratio.md\n\n"
+      "  dicesim sweep scenes/paper/sweeps/volume-ratio.toml --plot ratio.png --markdown ratio.md\n"
+      "  dicesim sweep scenes/paper/sweeps/height.toml --workers 4   # points as distributed runs\n\n"
       "Outputs: a table on stdout, or --json (one object); --csv FILE (columns param,face,count,p,lo,hi;\n"
       "'-' for stdout); --plot FILE.png|svg (gnuplot, 95% bands, the seed's values as circles);\n"
       "--markdown FILE (our table beside the seed's, with a chi-square test per point).");
@@ -407,6 +435,15 @@ void register_sweep(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(1ULL, 1ULL << 40));
   a->seed_opt = cmd->add_option("--seed", a->seed, "Run seed (default: the sweep file's, else 1)");
   cmd->add_option("-j,--threads", a->threads, "Worker threads (default: all cores)")->capture_default_str()->check(CLI::Range(1, 1024));
+  cmd->add_option("-w,--workers", a->workers,
+                  "Toss every point as a distributed run over LCM with K local `dicesim worker` processes\n"
+                  "(identical counts to the in-process sweep); workers started elsewhere on --lcm join too")
+      ->type_name("K")
+      ->check(CLI::Range(0, 256));
+  cmd->add_option("--lcm", a->lcm,
+                  "LCM URL for distributed points (implies a distributed sweep; default with --workers: a\n"
+                  "private host-confined URL, or $LCM_DEFAULT_URL if set)")
+      ->type_name("URL");
   cmd->add_flag("--json", a->json, "Print exactly one JSON object on stdout instead of the table");
   cmd->add_option("--csv", a->csv, "Write CSV: param,face,count,p,lo,hi ('-': stdout)")->type_name("FILE");
   cmd->add_option("--plot", a->plot, "Write a plot, FILE.png or FILE.svg (needs gnuplot)")->type_name("FILE");

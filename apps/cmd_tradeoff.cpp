@@ -125,10 +125,15 @@ int run_tradeoff(const TradeoffArgs& a) {
   const SceneDef base = a.scene.load();
   (void)compile(base, a.scene.path);  // bad scenes fail before any work
   std::vector<Row> rows;
-  rows.push_back({{Fidelity::Static, "-", 0.0}});
-  rows.push_back({{Fidelity::Paper, "stop_speed=" + num(base.sim.stop_speed), 0.0}});
-  for (double s : a.steps) rows.push_back({{Fidelity::Impulse, "contact_step=" + num(s), s}});
-  for (double s : a.steps) rows.push_back({{Fidelity::Stepped, "step=" + num(s), s}});
+  const auto row = [](Setting s) {
+    Row r;
+    r.setting = std::move(s);
+    return r;
+  };
+  rows.push_back(row({Fidelity::Static, "-", 0.0}));
+  rows.push_back(row({Fidelity::Paper, "stop_speed=" + num(base.sim.stop_speed), 0.0}));
+  for (double s : a.steps) rows.push_back(row({Fidelity::Impulse, "contact_step=" + num(s), s}));
+  for (double s : a.steps) rows.push_back(row({Fidelity::Stepped, "step=" + num(s), s}));
   for (Row& r : rows) {
     if (!a.json) std::fprintf(stderr, "  %-8s %-20s ...\r", to_string(r.setting.fidelity), r.setting.label.c_str());
     run_row(base, a, r);

@@ -2,7 +2,11 @@
 #include <csignal>
 #include <cstdio>
 
+#include <spdlog/spdlog.h>
+
 #include "apps/commands.hpp"
+#include "logger/log.hpp"
+#include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
 #include "sim/worker/worker.hpp"
 
@@ -29,7 +33,14 @@ int run_worker_cmd(const WorkerArgs& a) {
   opt.cancel = &g_stop;
   opt.core.only_run = a.run;
   opt.core.batch = a.batch;
-  if (!a.quiet) opt.core.log = [](const std::string& s) { std::fprintf(stderr, "dicesim worker: %s\n", s.c_str()); };
+  // The id is chosen here, not in WorkerCore, so that every log line can carry it from the start.
+  opt.core.worker_id = wire::new_run_id();
+  logging::set_worker_id(opt.core.worker_id);
+  logging::set_run_id(a.run);
+  opt.core.on_run = [only = a.run](std::int64_t run) { logging::set_run_id(run != 0 ? run : only); };
+  // --quiet (how `dicesim run` starts its workers) moves the worker's event lines to debug.
+  const auto level = a.quiet ? spdlog::level::debug : spdlog::level::info;
+  opt.core.log = [level](const std::string& s) { spdlog::log(level, "{}", s); };
   const int code = worker::run_worker(opt);
   if (code != 0) std::fprintf(stderr, "dicesim worker: failed: cannot open LCM at '%s'\n", opt.url.c_str());
   return code == 0 ? kExitOk : kExitFailed;
@@ -56,7 +67,7 @@ void register_worker(CLI::App& app, int& exit_code) {
   cmd->add_option("--batch", args->batch, "Tosses per published batch")
       ->capture_default_str()
       ->check(CLI::Range(1, wire::kMaxBatch));
-  cmd->add_flag("-q,--quiet", args->quiet, "No log lines on stderr");
+  cmd->add_flag("-q,--quiet", args->quiet, "Log the worker's events at debug level, not info (so none at the default level)");
   cmd->callback([args, &exit_code] { exit_code = run_worker_cmd(*args); });
 }
 

@@ -36,6 +36,10 @@ void register_compare(CLI::App& app, int& exit_code);    // cmd_compare.cpp
 void register_worker(CLI::App& app, int& exit_code);
 void register_aggregate(CLI::App& app, int& exit_code);
 void register_run(CLI::App& app, int& exit_code);
+void register_bridge(CLI::App& app, int& exit_code);  // cmd_bridge.cpp
+void register_watch(CLI::App& app, int& exit_code);   // cmd_watch.cpp
+void register_record(CLI::App& app, int& exit_code);  // cmd_record.cpp
+void register_replay(CLI::App& app, int& exit_code);  // cmd_replay.cpp
 
 // Distributed runs (cmd_aggregate.cpp): what `aggregate` and `run` share.
 struct AggregateArgs {
@@ -54,6 +58,10 @@ struct AggregateArgs {
 // `workers` (> 0) is reported as the thread count; `on_tick` may return an error to abort.
 int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::int64_t run_id, int workers,
                          const std::function<std::string()>& on_tick, const std::atomic<bool>* cancel);
+
+// --log-level and --log-file on `app` and each of its subcommands; logging is set up (logger/log.hpp)
+// once parsing is complete, before the subcommand runs (log_options.cpp). parse_and_run calls it.
+void add_log_options(CLI::App& app, int argc, char** argv);
 
 // Parses argv into `app` and runs the chosen callback (which sets exit_code); maps errors to exit
 // codes: help 0, bad usage or SceneError 2 (message on stderr, nothing on stdout), others 1.

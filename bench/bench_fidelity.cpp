@@ -2,9 +2,13 @@
 // fidelity, the friction impact law, one fixed step. The speed/accuracy table: `dicesim bench tradeoff`.
 #include <benchmark/benchmark.h>
 
+#include <vector>
+
 #include "sim/contact_stepper.hpp"
 #include "sim/die_model.hpp"
 #include "sim/friction_impact.hpp"
+#include "sim/initial_state.hpp"
+#include "sim/toss_random.hpp"
 #include "sim/toss.hpp"
 
 namespace {
@@ -45,6 +49,32 @@ void BM_FrictionImpactOneCorner(benchmark::State& st) {
   }
 }
 BENCHMARK(BM_FrictionImpactOneCorner);
+
+// The common case of sustained contact: one corner, perfectly plastic, mostly sliding. A fixed
+// set of 64 random approaching single-corner states (spin ~20 rad/s) cycled, so the mix includes
+// the strongly coupled states where the angle root-finder decides the slip direction.
+void BM_FrictionImpactPlasticCornerMix(benchmark::State& st) {
+  const DieModel m = die1_as(Fidelity::Impulse);
+  std::vector<RigidState> states;
+  TossRandom rng(14, 0);
+  while (states.size() < 64) {
+    RigidState s;
+    s.R = uniform_rotation(rng.uniform(), rng.uniform(), rng.uniform());
+    double low = 0.0;
+    for (const Vec3& v : m.vertices) low = std::min(low, (s.R * v).z());
+    s.position = Vec3(0, 0, -low);
+    s.velocity = Vec3(rng.normal(), rng.normal(), -3.0 * rng.uniform());
+    s.omega = 20.0 * Vec3(rng.normal(), rng.normal(), rng.normal());
+    const ContactSet c = touching_corners(m, s, 1e-6 * m.bounding_radius);
+    if (c.n == 1 && corner_velocity(m, s, c.vertex[0]).z() < 0.0) states.push_back(s);
+  }
+  std::size_t i = 0;
+  for (auto _ : st) {
+    RigidState s = states[i++ % states.size()];
+    benchmark::DoNotOptimize(apply_friction_impact(m, s, touching_corners(m, s, 1e-6 * m.bounding_radius), false));
+  }
+}
+BENCHMARK(BM_FrictionImpactPlasticCornerMix);
 
 // A die resting on a face: one step of the sustained-contact integrator (four corners).
 void BM_FixedStepOnFace(benchmark::State& st) {

@@ -5,7 +5,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
+#include <stdexcept>
 
 #include <toml++/toml.h>
 
@@ -151,6 +153,32 @@ DieModel compile_spec(const RunSpec& spec) {
   // The scene's name comes from the file's stem, as in `toss`; errors name the user's path.
   const fs::path main = dir / spec.files[0].path;
   return compile(load_scene(main.string(), spec.overrides), spec.origin);
+}
+
+RunSpec make_run_spec(std::int64_t run_id, const std::string& scene_path, const std::vector<std::string>& overrides,
+                      const DieModel& model, std::uint64_t seed, std::uint64_t total, int trace_every) {
+  RunSpec spec;
+  spec.run_id = run_id;
+  spec.origin = scene_path;
+  spec.files = read_scene_files(scene_path);
+  spec.overrides = overrides;
+  spec.fidelity = to_string(model.fidelity);
+  spec.seed = seed;
+  spec.total = total;
+  spec.trace_every = trace_every;
+  spec.fingerprint = model_fingerprint(model);
+  spec.hash = scene_hash(spec.files, overrides);
+  // What a worker will do with run_start, done here first: a run no worker could rebuild fails now.
+  if (model_fingerprint(compile_spec(spec)) != spec.fingerprint)
+    throw std::runtime_error("the scene does not rebuild identically from its files (run_start)");
+  return spec;
+}
+
+std::int64_t new_run_id() {
+  std::random_device rd;
+  std::uint64_t v = 0;
+  while (v == 0) v = ((std::uint64_t{rd()} << 32) ^ rd()) & INT64_MAX;
+  return static_cast<std::int64_t>(v);
 }
 
 dicesim_lcm::run_start to_message(const RunSpec& spec) {

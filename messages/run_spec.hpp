@@ -44,6 +44,16 @@ std::uint64_t model_fingerprint(const DieModel& m);
 // `dicesim toss` would load the original, and removes the directory. Throws SceneError.
 DieModel compile_spec(const RunSpec& spec);
 
+// The description of a run of `scene_path` with `overrides` (any fidelity choice among them),
+// whose compiled model is `model`. Checks that the description rebuilds into exactly that model,
+// as every worker will rebuild it, and throws std::runtime_error if not.
+RunSpec make_run_spec(std::int64_t run_id, const std::string& scene_path, const std::vector<std::string>& overrides,
+                      const DieModel& model, std::uint64_t seed, std::uint64_t total, int trace_every = 0);
+
+// A fresh non-zero run id (63 bits from std::random_device: run ids name runs, they never
+// influence a result).
+std::int64_t new_run_id();
+
 dicesim_lcm::run_start to_message(const RunSpec& spec);
 RunSpec from_message(const dicesim_lcm::run_start& msg);
 

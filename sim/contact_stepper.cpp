@@ -7,8 +7,18 @@
 
 namespace dicesim {
 
-FixedStepper::FixedStepper(const DieModel& m, double h)
-    : m_(&m), h_(h), v_impact_(4.0 * m.gravity * h), touch_tol_(1e-9 * m.bounding_radius) {}
+FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshold)
+    : m_(&m),
+      h_(h),
+      v_impact_(4.0 * m.gravity * h),
+      touch_tol_(1e-9 * m.bounding_radius) {
+  if (threshold == ImpactThreshold::Contact) {
+    const double r = m.bounding_radius;
+    const double lever = m.mass * r * r / m.principal_moments.minCoeff();
+    v_impact_ *= 1.0 + (1.0 + m.max_friction) * lever;
+    v_spin_ = 4.0 * h * r;
+  }
+}
 
 int FixedStepper::step(RigidState& s) {
   const DieModel& m = *m_;
@@ -21,7 +31,7 @@ int FixedStepper::step(RigidState& s) {
     if (n > 0) {
       double un = 0.0;
       for (int i = 0; i < n; ++i) un = std::min(un, corner_velocity(m, s, c.vertex[i]).z());
-      const bool impact = un < -v_impact_;
+      const bool impact = un < -(v_impact_ + v_spin_ * s.omega.squaredNorm());
       const ImpactResult r = apply_friction_impact(m, s, c, impact);
       if (impact) ++impacts;
       if (r.energy_clamped) ++energy_clamps;
@@ -50,9 +60,9 @@ int FixedStepper::step(RigidState& s) {
 }
 
 StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int& impacts, double h, double tiebreak,
-                               bool allow_liftoff) {
+                               bool allow_liftoff, ImpactThreshold threshold) {
   StepperOutcome out;
-  FixedStepper st(m, h);
+  FixedStepper st(m, h, threshold);
   st.impacts = impacts;
   const double g = m.gravity, r = m.bounding_radius;
   const double ke_rest = 1e-14 * m.mass * g * r;

@@ -1,9 +1,9 @@
 // Fixed-step time integration of the die with the floor: gravity, torque-free rotation (world
 // angular momentum held between impulses), and at every step the corners touching the floor
 // solved together with Coulomb friction (sim/friction_impact.hpp): with restitution when a corner
-// arrives faster than 4 g h (an impact), perfectly plastic otherwise (sustained contact: resting,
-// sliding, rolling, tipping). Semi-implicit Euler, first order: the answer converges as h -> 0.
-// The whole of the `stepped` fidelity, and `impulse`'s sustained-contact phases.
+// arrives faster than the impact threshold (an impact), perfectly plastic otherwise (sustained
+// contact: resting, sliding, rolling, tipping). Semi-implicit Euler, first order: the answer
+// converges as h -> 0. The whole of the `stepped` fidelity, and `impulse`'s sustained-contact phases.
 #pragma once
 
 #include "sim/die_model.hpp"
@@ -11,9 +11,23 @@
 
 namespace dicesim {
 
+// Which approach speed makes a step's contact an impact (restitution, counted against
+// sim.max_bounces) rather than sustained contact (plastic, not counted).
+//  Gravity: 4 g h, what gravity alone adds in a step (`impulse`'s sustained contact, unchanged).
+//  Contact: 4 h (g k + |w|^2 r), r the bounding radius, k = 1 + (1 + mu_max) m r^2 / I_min: the
+//   bound on a corner's acceleration in sustained contact, i.e. gravity, the centripetal term of
+//   the spin, and the angular acceleration that contact forces of order m g (normal plus friction)
+//   at lever r give. Under the gravity threshold a die sliding flat on a face rocks from corner to
+//   corner (friction pitches it; one corner touches per step) with corners arriving at ~8 g h,
+//   and a fast-spinning contact corner drifts in by ~w^2 r h per step: every step was a counted,
+//   bouncing impact, so the count grew like 1/h and fine steps hit sim.max_bounces. Both
+//   thresholds vanish with h (a genuine impact arrives at a speed that does not), so the limit
+//   h -> 0 is the same physics.
+enum class ImpactThreshold { Gravity, Contact };
+
 class FixedStepper {
  public:
-  FixedStepper(const DieModel& m, double h);
+  FixedStepper(const DieModel& m, double h, ImpactThreshold threshold = ImpactThreshold::Gravity);
 
   // Advances s by one step h. Returns the number of corners that were in contact.
   int step(RigidState& s);
@@ -25,6 +39,7 @@ class FixedStepper {
  private:
   const DieModel* m_;
   double h_, v_impact_, touch_tol_;
+  double v_spin_ = 0.0;  // Contact: 4 h r (the factor of |w|^2)
 };
 
 enum class StepperExit { Settled, LiftOff, Unresolved };
@@ -40,6 +55,6 @@ struct StepperOutcome {
 // steps (the caller's exact flight takes over). A die at rest in an exact unstable balance (on an
 // edge or corner) gets an infinitesimal spin whose direction comes from `tiebreak`.
 StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int& impacts, double h, double tiebreak,
-                               bool allow_liftoff);
+                               bool allow_liftoff, ImpactThreshold threshold = ImpactThreshold::Gravity);
 
 }  // namespace dicesim

@@ -3,7 +3,8 @@
 //
 //  - One contact point: the perfectly plastic frictional impulse first (exact: the sticking impulse
 //    P_I = -W^-1 u if |P_I,t| <= mu P_I,n, W the contact compliance and u the contact-point velocity
-//    v + w x r; else sliding with maximal dissipation, zero final normal velocity). Then
+//    v + w x r; else sliding with maximal dissipation, zero final normal velocity, the slip
+//    direction found as a bracketed root in its angle; only a jam falls back to PGS). Then
 //    restitution e of that corner: sticking -> Chatterjee & Ruina (1998) with tangential
 //    restitution 0, P = P_I + e (P_I.n) n; sliding -> Poisson, P = (1 + e) P_slide. (CR's own
 //    projection of (1+e) P_I,n n + P_I,t onto the cone keeps the sticking normal impulse and makes

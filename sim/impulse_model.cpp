@@ -15,6 +15,7 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
   double t = 0.0;
   const double set_tol = 1e-6 * m.bounding_radius;  // corners this close strike together
   bool sustained = false;
+  bool after_impact = false;  // the state is right after an impact (sustained contact is possible)
   const auto settle = [&](int down) {
     r.status = TossStatus::Settled;
     r.face_index = opposite_face(down);
@@ -39,6 +40,14 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
       probe->search_iterations += static_cast<std::uint64_t>(c.iterations);
       ++probe->flights;
     }
+    // A rebound that lands again within one contact step is sustained contact. (The one search
+    // from the state after the impact both decides that and, if not, is the next flight's.)
+    if (after_impact && c.outcome == ContactSearch::Outcome::Contact && c.t <= m.contact_step) {
+      sustained = true;
+      after_impact = false;
+      continue;
+    }
+    after_impact = false;
     if (c.outcome != ContactSearch::Outcome::Contact) {
       t += c.t;
       break;
@@ -53,10 +62,7 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
     if (probe && probe->trace)
       probe->trace->push_back({r.bounces, t, before, s, set.n > 0 ? set.vertex[0] : -1, imp.normal_impulse});
     if (r.bounces >= m.max_bounces) break;
-
-    // A rebound that lands again within one contact step is sustained contact.
-    const Flight next(m, s);
-    sustained = next.next_contact(m.contact_step).outcome == ContactSearch::Outcome::Contact;
+    after_impact = true;
   }
   r.status = TossStatus::Unresolved;
   r.t_end = t;

@@ -64,19 +64,28 @@ int quasi_static_down_face(const DieModel& m, const Mat3& R, double tiebreak) {
     dh = Vec3(std::cos(a), std::sin(a), 0.0);
   }
   const Vec3 axis = Vec3::UnitZ().cross(dh).normalized();
+  // The first theta in [0, pi] with A cos + B sin = 0 is atan2(A, -B); on [0, pi] the angle
+  // grows with -cos(theta) = B / hypot(A, B), so the smallest is found, and its cos and sin are
+  // known, without any trigonometric call.
   int q = -1;
-  double theta = std::numeric_limits<double>::infinity();
+  double key = std::numeric_limits<double>::infinity(), cos_t = 1.0, sin_t = 0.0;
   for (int k = 0; k < 3; ++k) {
     const int j = p ^ (1 << k);
     const Vec3 u = w[j] - w[p];
     const double A = std::max(0.0, u.z()), B = axis.cross(u).z();
-    const double t = std::atan2(A, -B);  // first theta in [0, pi] with A cos + B sin = 0
-    if (t < theta) {
-      theta = t;
+    const double h = std::sqrt(A * A + B * B);
+    const double kk = h > 0.0 ? B / h : -1.0;  // (a degenerate edge: theta = 0)
+    if (kk < key) {
+      key = kk;
       q = j;
+      cos_t = h > 0.0 ? -B / h : 1.0;
+      sin_t = h > 0.0 ? A / h : 0.0;
     }
   }
-  const Mat3 rot = Eigen::AngleAxisd(theta, axis).toRotationMatrix();
+  // Rodrigues: rot = cos I + sin [axis]x + (1 - cos) axis axis^T.
+  Mat3 cross_axis;
+  cross_axis << 0.0, -axis.z(), axis.y(), axis.z(), 0.0, -axis.x(), -axis.y(), axis.x(), 0.0;
+  const Mat3 rot = cos_t * Mat3::Identity() + sin_t * cross_axis + (1.0 - cos_t) * (axis * axis.transpose());
 
   // 2. Tip about edge p-q toward the side of the COM.
   const Vec3 c = rot * (-w[p]);

@@ -9,7 +9,8 @@ TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossPro
   TossResult r;
   double t = 0.0;
   int impacts = 0;
-  const StepperOutcome o = run_fixed_steps(m, s, t, impacts, m.step, tiebreak, /*allow_liftoff=*/false);
+  const StepperOutcome o = run_fixed_steps(m, s, t, impacts, m.step, tiebreak, /*allow_liftoff=*/false,
+                                           ImpactThreshold::Contact);
   if (probe) probe->flights += 1;
   r.bounces = impacts;
   r.t_end = t;

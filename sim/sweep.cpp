@@ -331,11 +331,13 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   // Every point is loaded and compiled before the first toss: a bad value fails at once.
   std::vector<DieModel> models;
+  std::vector<std::vector<std::string>> overrides;
   models.reserve(spec.points.size());
   for (const SweepPoint& p : spec.points) {
     std::vector<std::string> all = spec.overrides;
     all.insert(all.end(), p.overrides.begin(), p.overrides.end());
     models.push_back(compile(load_scene(spec.scene, all), spec.scene));
+    overrides.push_back(std::move(all));
   }
   SweepResult out;
   const std::uint64_t total = spec.tosses * spec.points.size();
@@ -348,14 +350,21 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
     cfg.threads = opt.threads;
     cfg.cancel = opt.cancel;
     const std::uint64_t before = spec.tosses * i;
-    // run_tosses' progress reporter wakes every ~100 ms and is joined at the end of the run, which
-    // would add up to 0.1 s per point: only long points report from inside, the others per point.
-    constexpr std::uint64_t kLongPoint = 200000;
-    if (opt.progress && spec.tosses >= kLongPoint)
-      cfg.progress = [&opt, before, total](std::uint64_t done, std::uint64_t) { opt.progress(before + done, total); };
     SweepPointResult r;
     r.point = spec.points[i];
-    r.counts = run_tosses(models[i], cfg);
+    if (opt.run_point) {
+      r.counts = opt.run_point(models[i], overrides[i], cfg, [&opt, before, total](std::uint64_t done) {
+        if (opt.progress) opt.progress(before + done, total);
+      });
+    } else {
+      // run_tosses' progress reporter wakes every ~100 ms and is joined at the end of the run, which
+      // would add up to 0.1 s per point: only long points report from inside, the others per point.
+      constexpr std::uint64_t kLongPoint = 200000;
+      if (opt.progress && spec.tosses >= kLongPoint)
+        cfg.progress = [&opt, before, total](std::uint64_t done, std::uint64_t) { opt.progress(before + done, total); };
+      r.counts = run_tosses(models[i], cfg);
+    }
+    if (opt.cancel && opt.cancel->load()) break;  // a cancelled point is incomplete: not reported
     r.labels = models[i].face_labels;
     r.fidelity = to_string(models[i].fidelity);
     out.points.push_back(std::move(r));

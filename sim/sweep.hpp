@@ -100,6 +100,12 @@ struct SweepRunOptions {
   // (tosses done over the whole sweep, total) about every 100 ms.
   std::function<void(std::uint64_t, std::uint64_t)> progress;
   const std::atomic<bool>* cancel = nullptr;
+  // How one point is tossed; empty: run_tosses in this process. `overrides` are the point's full
+  // list (the sweep's, then its own), so a distributed runner can describe the run to workers.
+  // `progress` (tosses done of this point) may be called from any thread.
+  using PointRunner = std::function<RunCounts(const DieModel& model, const std::vector<std::string>& overrides,
+                                              const RunConfig& cfg, const std::function<void(std::uint64_t)>& progress)>;
+  PointRunner run_point;
 };
 
 // Loads and compiles every point first (bad input fails before any toss), then tosses each with

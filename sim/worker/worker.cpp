@@ -65,6 +65,7 @@ void WorkerCore::on_run_start(const dicesim_lcm::run_start& m, double now) {
   if (run_) end_run("replaced by a newer run");
   run_ = std::make_unique<Run>();
   run_->spec = wire::from_message(m);
+  if (cfg_.on_run) cfg_.on_run(m.run_id);
   run_->last_heard = now;
   leases_.clear();
   last_lease_seen_ = last_done_ = 0;
@@ -111,6 +112,7 @@ void WorkerCore::end_run(const char* why) {
              " tosses by this worker)");
   ended_runs_.insert(run_->spec.run_id);
   run_.reset();
+  if (cfg_.on_run) cfg_.on_run(0);
   leases_.clear();
   ++runs_finished_;
 }

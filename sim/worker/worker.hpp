@@ -29,6 +29,7 @@ struct WorkerConfig {
   double run_silence_s = 5.0;        // no run_start for this long: the run is gone
   double max_trace_per_s = 2000.0;   // bounce_state messages per second at most (publishers pace themselves)
   std::function<void(const std::string&)> log;  // human-readable events (stderr)
+  std::function<void(std::int64_t run_id)> on_run;  // the run served changed (0: none); e.g. log context
 };
 
 class WorkerCore {

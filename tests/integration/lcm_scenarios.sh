@@ -3,7 +3,7 @@
 # this script creates for itself (only loopback, with a multicast route): nothing it sends can
 # leave the namespace. Run by CTest (tests/CMakeLists.txt), one scenario per test:
 #   lcm_scenarios.sh DICESIM_BINARY LCM_INJECT_BINARY SCENARIO
-# Scenarios: three_workers kill9 drop10 replay late_join hostile run_cmd interrupt target trace
+# Scenarios: three_workers kill9 drop10 replay late_join hostile run_cmd sweep_workers interrupt target trace
 # Every scenario compares the distributed JSON with `dicesim toss --threads 1` after removing
 # only the keys that may differ (elapsed_s, tosses_per_s, threads): identical counts, p, CIs.
 set -euo pipefail
@@ -143,6 +143,23 @@ case "$scenario" in
     grep -q '"threads":2' "$work/out.json" || fail "threads should report the 2 workers"
     sleep 0.2
     if pgrep -f -- "--lcm $url" > /dev/null; then fail "worker processes left behind"; fi
+    ;;
+  sweep_workers)
+    # `dicesim sweep --workers`: every point a distributed run (one local worker process plus one
+    # started outside that joins over --lcm); the counts equal the in-process sweep's at every point.
+    sweep_args=(--param floor.restitution --values 0.3,0.9 --tosses 6000 --seed "$seed" --json)
+    "$bin" sweep "$scene" "${sweep_args[@]}" --threads 2 > "$work/ref.json" || fail "in-process sweep exited $?"
+    url="udpm://239.255.76.67:$((30000 + $$ % 20000))?ttl=0"
+    "$bin" worker --lcm "$url" 2> "$work/worker1.err" & pids+=($!)  # serves every run, not --once
+    "$bin" sweep "$scene" "${sweep_args[@]}" --workers 1 --lcm "$url" > "$work/out.json" 2> "$work/sweep.err" ||
+      fail "dicesim sweep --workers exited $?"
+    strip() { jq -c 'del(.elapsed_s, .tosses_per_s, .threads, .workers)' "$1"; }
+    [ "$(strip "$work/ref.json")" = "$(strip "$work/out.json")" ] || fail "distributed sweep counts differ from the in-process sweep"
+    [ "$(jq '.points | length' "$work/out.json")" = 2 ] || fail "expected 2 points"
+    [ "$(jq '.workers' "$work/out.json")" = 1 ] || fail "workers should report the 1 local worker"
+    [ "$(grep -c "ended: finished" "$work/worker1.err")" = 2 ] || fail "the outside worker did not serve both points"
+    sleep 0.2
+    if pgrep -f -- "--lcm $url --quiet" > /dev/null; then fail "local worker processes left behind"; fi
     ;;
   interrupt)
     # Ctrl-C on `dicesim run`: exit 1, no result on stdout, no worker left behind.

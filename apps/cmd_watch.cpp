@@ -1,0 +1,106 @@
+// dicesim watch: follow runs live from the LCM bus, one line per answer the aggregator
+// publishes (DICESIM_PROBABILITIES), until Ctrl-C, or until a run finishes (--until-finished).
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "apps/commands.hpp"
+#include "messages/wire.hpp"
+
+namespace dicesim {
+namespace {
+
+std::atomic<bool> g_stop{false};
+void on_stop_signal(int) { g_stop = true; }
+
+struct WatchArgs {
+  std::string lcm;
+  std::int64_t run = 0;
+  bool until_finished = false;
+  double timeout_s = 0.0;
+};
+
+// One answer as one line: progress, workers, and each face's p with its 95% half-width.
+std::string answer_line(const dicesim_lcm::probabilities& m) {
+  char buf[160];
+  const double pct = m.total > 0 ? 100.0 * static_cast<double>(m.done) / static_cast<double>(m.total) : 0.0;
+  std::snprintf(buf, sizeof buf, "run %lld  %s %lld/%lld (%.1f%%)  %d workers |", static_cast<long long>(m.run_id),
+                m.finished ? "FINISHED" : "running", static_cast<long long>(m.done), static_cast<long long>(m.total),
+                pct, m.workers);
+  std::string line = buf;
+  for (int f = 0; f < 6; ++f) {
+    std::snprintf(buf, sizeof buf, "  %d: %.4f±%.4f", m.face_labels[f], m.p[f], 0.5 * (m.ci_hi[f] - m.ci_lo[f]));
+    line += buf;
+  }
+  if (m.unresolved || m.invalid) {
+    std::snprintf(buf, sizeof buf, "  (unresolved %lld, invalid %lld)", static_cast<long long>(m.unresolved),
+                  static_cast<long long>(m.invalid));
+    line += buf;
+  }
+  return line;
+}
+
+struct Printer {
+  const WatchArgs* args;
+  bool finished = false;
+  void handle(const lcm::ReceiveBuffer* rb, const std::string&) {
+    const auto m = wire::decode<dicesim_lcm::probabilities>(rb->data, rb->data_size);
+    if (!m || (args->run != 0 && m->run_id != args->run)) return;
+    std::printf("%s\n", answer_line(*m).c_str());
+    std::fflush(stdout);
+    if (m->finished) finished = true;
+  }
+};
+
+int watch(const WatchArgs& a) {
+  const std::string url = wire::resolve_url(a.lcm);
+  lcm::LCM bus(url);
+  if (!bus.good()) {
+    std::fprintf(stderr, "dicesim: failed: cannot open LCM at '%s'\n", url.c_str());
+    return kExitFailed;
+  }
+  Printer printer{&a};
+  bus.subscribe(wire::kProbabilities, &Printer::handle, &printer);
+  std::signal(SIGINT, on_stop_signal);
+  std::signal(SIGTERM, on_stop_signal);
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!g_stop && !(a.until_finished && printer.finished)) {
+    bus.handleTimeout(100);
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (a.timeout_s > 0 && t > a.timeout_s) {
+      std::fprintf(stderr, "dicesim: failed: %s after %g s\n", a.until_finished ? "no run finished" : "timed out",
+                   a.timeout_s);
+      return kExitFailed;
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void register_watch(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<WatchArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "watch",
+      "Follow runs live: one line per answer an aggregator publishes on DICESIM_PROBABILITIES\n"
+      "(4 a second): progress, live workers, each face's probability with its 95% half-width.\n"
+      "Runs until Ctrl-C, or until a run finishes with --until-finished.\n\n"
+      "Examples:\n"
+      "  dicesim watch\n"
+      "  dicesim watch --until-finished --lcm 'udpm://239.255.76.67:7667?ttl=1'");
+  cmd->add_option("--lcm", args->lcm,
+                  "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0, which never leaves this host)")
+      ->type_name("URL");
+  cmd->add_option("--run", args->run, "Only this run id");
+  cmd->add_flag("--until-finished", args->until_finished, "Exit 0 after a run's final answer");
+  cmd->add_option("--timeout", args->timeout_s, "Fail (exit 1) after this many seconds (0: never)")
+      ->type_name("S")
+      ->check(CLI::Range(0.0, 1e9));
+  cmd->callback([args, &exit_code] { exit_code = watch(*args); });
+}
+
+}  // namespace dicesim

@@ -1,0 +1,37 @@
+// Local worker processes for the commands that start their own (`run`, `sweep --workers`): this
+// same binary as `dicesim worker`, stopped whatever happens to the parent (RAII, and
+// PR_SET_PDEATHSIG should the parent be killed outright).
+#pragma once
+
+#include <sys/types.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dicesim {
+
+class WorkerProcesses {
+ public:
+  WorkerProcesses() = default;
+  WorkerProcesses(const WorkerProcesses&) = delete;
+  WorkerProcesses& operator=(const WorkerProcesses&) = delete;
+  ~WorkerProcesses() { stop_all(); }
+
+  // Starts `dicesim worker --lcm URL --quiet`; with run_id != 0 it serves only that run and exits
+  // after it (--run ID --once), with 0 it serves every run on the URL in turn.
+  bool spawn(const std::string& url, std::int64_t run_id);
+  // Reaps exited workers (warning on stderr for abnormal exits); returns how many still run.
+  int poll();
+  // SIGTERM, then SIGKILL for those still running after 2 s.
+  void stop_all();
+
+ private:
+  std::vector<pid_t> pids_;
+};
+
+// A URL on the host-confined multicast group with a port of its own (20000-59999, random), so
+// that two local runs on one machine never meet.
+std::string private_lcm_url();
+
+}  // namespace dicesim

@@ -1,0 +1,179 @@
+#!/usr/bin/env bash
+# The LCM -> DDS bridge with real processes, each scenario inside a private network namespace
+# this script creates (only loopback: nothing can leave it). Run by CTest, one scenario per test:
+#   dds_scenarios.sh DICESIM_BINARY DDS_SUBSCRIBER_BINARY LCM_INJECT_BINARY SCENARIO
+# Scenarios: late_subscriber final_values restart replay (tests/integration/README.md).
+# The bridge finds its loopback configuration by itself (bridge/cyclonedds-loopback.xml next to
+# the build); the example subscriber is pointed at the same file with CYCLONEDDS_URI.
+set -euo pipefail
+
+if [ "${DICESIM_NETNS:-}" != "1" ]; then
+  if [ "$(id -u)" -ne 0 ]; then echo "SKIP: network namespaces need root"; exit 77; fi
+  exec unshare --net env DICESIM_NETNS=1 "$0" "$@"
+fi
+ip link set lo up
+ip link set lo multicast on
+ip route add 224.0.0.0/4 dev lo
+export LCM_DEFAULT_URL="udpm://239.255.76.67:7667?ttl=0"
+
+bin=$1 sub=$2 inject=$3 scenario=$4
+src_dir=$(cd "$(dirname "$0")/../.." && pwd)
+cd "$src_dir"
+work=$(mktemp -d /tmp/dicesim-dds-XXXXXX)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  rm -rf "$work"
+}
+trap cleanup EXIT
+
+scene=scenes/paper/die1.toml
+seed=11
+fail() {
+  echo "FAIL [$scenario]: $*" >&2
+  for f in "$work"/*.err "$work"/*.jsonl; do [ -f "$f" ] && { echo "--- $f" >&2; tail -n 15 "$f" >&2; }; done
+  exit 1
+}
+
+# The subscriber, as any external program would run it (only the config file from the repo).
+subscriber() { CYCLONEDDS_URI="file://$src_dir/bridge/cyclonedds-loopback.xml" "$sub" --json "$@"; }
+bridge() { "$bin" bridge "$@" 2> "$work/bridge.err" & bridge_pid=$!; pids+=($bridge_pid); }
+nworkers=0
+worker() { nworkers=$((nworkers + 1)); "$bin" worker "$@" 2> "$work/worker$nworkers.err" & pids+=($!); }
+
+# Run ids are 63-bit: jq would round them to doubles, so they are read as text.
+run_id() { grep -oE '"run_id":-?[0-9]+' | head -n1 | cut -d: -f2; }
+# The finished answer of run $2 in subscriber output $1 equals the aggregator's JSON $3:
+# identical counts, and p and the 95% interval identical to the last bit.
+same_as_json() {
+  local line
+  line=$(grep '"topic":"dicesim_probabilities"' "$1" | grep -F "\"run_id\":$2," | grep '"finished":true' | tail -n1)
+  [ -n "$line" ] || fail "no finished answer of run $2 in $1"
+  echo "$line" > "$work/dds_final.json"
+  jq -e --slurpfile d "$work/dds_final.json" '
+      $d[0] as $d
+      | .settled == $d.settled and .unresolved == $d.unresolved and .invalid == $d.invalid
+        and .tosses == $d.done and ([.faces[] | [.face, .count, .p, .ci95]] == [$d.faces[] | [.face, .count, .p, .ci95]])' \
+      "$3" > /dev/null || { echo "aggregator: $(jq -c '{settled, unresolved, invalid, faces}' "$3")" >&2;
+                            echo "over DDS:   $(cat "$work/dds_final.json")" >&2;
+                            fail "values over DDS differ from the aggregator's JSON"; }
+}
+# The bridge stops cleanly on a signal: exit 0 within 2 s, with its summary line.
+stops_cleanly() {
+  kill "-$1" "$bridge_pid"
+  for _ in $(seq 20); do kill -0 "$bridge_pid" 2>/dev/null || break; sleep 0.1; done
+  kill -0 "$bridge_pid" 2>/dev/null && fail "bridge still running 2 s after SIG$1"
+  local code=0; wait "$bridge_pid" || code=$?
+  [ "$code" -eq 0 ] || fail "bridge exited $code after SIG$1"
+  grep -q "bridge stopped" "$work/bridge.err" || fail "no summary line from the bridge"
+}
+
+case "$scenario" in
+  late_subscriber)
+    # A subscriber that joins mid-run gets the run's latest answer within 2 s; one that joins
+    # after the run ended (nobody publishes any more) still gets the final answer: transient-local.
+    n=3000000
+    bridge
+    worker --once; worker --once
+    "$bin" aggregate "$scene" --tosses $n --seed $seed --json --timeout 150 > "$work/agg.json" 2> "$work/agg.err" & agg=$!
+    pids+=($agg)
+    "$inject" progress 0.1 60 || fail "the run never reached 10%, or finished first"
+    start=$(date +%s%N)
+    subscriber --topic probabilities --count 1 --timeout 2 > "$work/late.jsonl" || fail "mid-run subscriber: no answer within 2 s"
+    took_ms=$(( ($(date +%s%N) - start) / 1000000 ))
+    jq -e --argjson n $n '.done >= 0.1 * $n and .total == $n' "$work/late.jsonl" > /dev/null ||
+      fail "the mid-run answer is not the run's latest (done < 10%): $(cat "$work/late.jsonl")"
+    echo "mid-run subscriber: first answer after $took_ms ms (process start included), done $(jq .done "$work/late.jsonl") of $n"
+    wait "$agg" || fail "aggregate exited $?"
+    run=$(run_id < "$work/late.jsonl")
+    sleep 0.5
+    start=$(date +%s%N)
+    subscriber --topic probabilities --until-finished --timeout 2 > "$work/after.jsonl" ||
+      fail "subscriber started after the run: no finished answer within 2 s"
+    took_ms=$(( ($(date +%s%N) - start) / 1000000 ))
+    echo "subscriber after the run: final answer after $took_ms ms"
+    same_as_json "$work/after.jsonl" "$run" "$work/agg.json"
+    stops_cleanly INT
+    ;;
+  final_values)
+    # `dicesim run --json` (its own LCM port) and a subscriber listening all along: the last
+    # answer over DDS is the printed result; the status topic saw the run through to finished.
+    url="udpm://239.255.76.67:$((30000 + $$ % 20000))?ttl=0"
+    bridge --lcm "$url"
+    subscriber --until-finished --timeout 120 > "$work/live.jsonl" 2> "$work/sub.err" & subp=$!; pids+=($subp)
+    "$bin" watch --lcm "$url" --until-finished --timeout 120 > "$work/watch.out" 2> "$work/watch.err" & watchp=$!; pids+=($watchp)
+    sleep 0.5
+    "$bin" run "$scene" --workers 2 --tosses 400000 --seed $seed --json --lcm "$url" > "$work/run.json" 2> "$work/run.err" ||
+      fail "dicesim run exited $?"
+    wait "$subp" || fail "subscriber exited $? (no finished answer)"
+    run=$(grep '"topic":"dicesim_probabilities"' "$work/live.jsonl" | tail -n1 | run_id)
+    same_as_json "$work/live.jsonl" "$run" "$work/run.json"
+    answers=$(grep -c '"topic":"dicesim_probabilities"' "$work/live.jsonl")
+    echo "answers received live: $answers"
+    # `dicesim watch` (the CLI way to watch) saw the same run to its end.
+    wait "$watchp" || fail "dicesim watch exited $?"
+    grep -q "^run $run  FINISHED 400000/400000" "$work/watch.out" || fail "dicesim watch did not print the finished run"
+    sleep 0.3
+    subscriber --topic status --count 1 --timeout 2 > "$work/status.jsonl" || fail "no run status"
+    grep -qF "\"run_id\":$run," "$work/status.jsonl" || fail "run status of another run: $(cat "$work/status.jsonl")"
+    jq -e '.state == "finished" and .origin == "scenes/paper/die1.toml" and .seed == 11 and .total_tosses == 400000' \
+      "$work/status.jsonl" > /dev/null || fail "run status is not finished/complete: $(cat "$work/status.jsonl")"
+    stops_cleanly TERM
+    ;;
+  restart)
+    # An aggregator killed mid-run (kill -9), then a new run with a new id on the same bus:
+    # the bridge keeps going, marks the dead run silent, publishes the new run to the end, and
+    # a late subscriber sees both runs' latest answers (one instance per run id).
+    bridge
+    worker; worker  # long-lived workers: they serve both runs
+    subscriber > "$work/all.jsonl" 2> "$work/sub.err" & pids+=($!)
+    "$bin" aggregate "$scene" --tosses 50000000 --seed 5 --json > /dev/null 2> "$work/agg1.err" & agg1=$!; pids+=($agg1)
+    "$inject" progress 0.002 60 || fail "the first run never started"
+    kill -9 "$agg1"
+    sleep 0.3
+    run1=$(grep '"topic":"dicesim_probabilities"' "$work/all.jsonl" | head -n1 | run_id)
+    [ -n "$run1" ] || fail "no answer of the first run over DDS"
+    "$bin" aggregate "$scene" --tosses 300000 --seed $seed --json --timeout 120 > "$work/agg2.json" 2> "$work/agg2.err" ||
+      fail "second aggregate exited $?"
+    sleep 0.5
+    run2=$(grep '"topic":"dicesim_probabilities"' "$work/all.jsonl" | grep '"finished":true' | tail -n1 | run_id)
+    [ -n "$run2" ] || fail "no finished answer of the second run over DDS"
+    [ "$run1" != "$run2" ] || fail "the second run has the first one's id"
+    kill -0 "$bridge_pid" 2>/dev/null || fail "the bridge died"
+    same_as_json "$work/all.jsonl" "$run2" "$work/agg2.json"
+    # The first run's aggregator is silent for > 3 s by now (or soon): its status says so.
+    for _ in $(seq 40); do
+      grep -q "\"run_id\":$run1,[^}]*\"state\":\"silent\"" "$work/all.jsonl" && break
+      sleep 0.1
+    done
+    grep -q "\"run_id\":$run1,[^}]*\"state\":\"silent\"" "$work/all.jsonl" || fail "the killed run was never marked silent"
+    grep -q "\"run_id\":$run2,[^}]*\"state\":\"finished\"" "$work/all.jsonl" || fail "the second run's status never said finished"
+    subscriber --topic probabilities --count 2 --timeout 2 > "$work/late.jsonl" || fail "late subscriber: not both runs within 2 s"
+    [ "$(grep -oE '"run_id":-?[0-9]+' "$work/late.jsonl" | cut -d: -f2 | sort | tr '\n' ' ')" = "$(printf '%s\n' "$run1" "$run2" | sort | tr '\n' ' ')" ] ||
+      fail "late subscriber did not get one latest answer per run: $(cat "$work/late.jsonl")"
+    echo "runs $run1 (killed) and $run2 (finished) both on DDS"
+    stops_cleanly TERM
+    ;;
+  replay)
+    # A recorded run replayed at recorded pace (`dicesim replay --live`) drives the bridge to the
+    # same final values as the live run printed.
+    url="udpm://239.255.76.67:$((30000 + $$ % 20000))?ttl=0"
+    "$bin" record --lcm "$url" -o "$work/run.lcmlog" --until-done --timeout 120 2> "$work/record.err" & rec=$!; pids+=($rec)
+    sleep 0.5
+    "$bin" run "$scene" --workers 2 --tosses 200000 --seed $seed --json --lcm "$url" > "$work/run.json" 2> "$work/run.err" ||
+      fail "dicesim run exited $?"
+    wait "$rec" || fail "dicesim record exited $?"
+    [ -s "$work/run.lcmlog" ] || fail "nothing recorded"
+    bridge  # on the default URL: only the replay speaks there
+    subscriber --topic probabilities --until-finished --timeout 120 > "$work/replayed.jsonl" 2> "$work/sub.err" & subp=$!; pids+=($subp)
+    sleep 0.5
+    "$bin" replay "$work/run.lcmlog" --live --speed 2 2> "$work/replay.err" > /dev/null || fail "dicesim replay --live exited $?"
+    wait "$subp" || fail "no finished answer over DDS from the replay"
+    run=$(tail -n1 "$work/replayed.jsonl" | run_id)
+    same_as_json "$work/replayed.jsonl" "$run" "$work/run.json"
+    stops_cleanly TERM
+    ;;
+  *) echo "unknown scenario $scenario" >&2; exit 2 ;;
+esac
+echo "PASS [$scenario]"
