@@ -13,9 +13,11 @@ FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshol
       v_impact_(4.0 * m.gravity * h),
       touch_tol_(1e-9 * m.bounding_radius) {
   if (threshold == ImpactThreshold::Contact) {
+    // Gravity keeps its safety factor 4; contact forces of order m g (normal plus friction) at
+    // lever r add at most (1 + mu) g m r^2 / I_min per unit time; the spin adds |w|^2 r (factor 4).
     const double r = m.bounding_radius;
     const double lever = m.mass * r * r / m.principal_moments.minCoeff();
-    v_impact_ *= 1.0 + (1.0 + m.max_friction) * lever;
+    v_impact_ += h * m.gravity * (1.0 + m.max_friction) * lever;
     v_spin_ = 4.0 * h * r;
   }
 }

@@ -14,15 +14,15 @@ namespace dicesim {
 // Which approach speed makes a step's contact an impact (restitution, counted against
 // sim.max_bounces) rather than sustained contact (plastic, not counted).
 //  Gravity: 4 g h, what gravity alone adds in a step (`impulse`'s sustained contact, unchanged).
-//  Contact: 4 h (g k + |w|^2 r), r the bounding radius, k = 1 + (1 + mu_max) m r^2 / I_min: the
-//   bound on a corner's acceleration in sustained contact, i.e. gravity, the centripetal term of
-//   the spin, and the angular acceleration that contact forces of order m g (normal plus friction)
-//   at lever r give. Under the gravity threshold a die sliding flat on a face rocks from corner to
-//   corner (friction pitches it; one corner touches per step) with corners arriving at ~8 g h,
-//   and a fast-spinning contact corner drifts in by ~w^2 r h per step: every step was a counted,
-//   bouncing impact, so the count grew like 1/h and fine steps hit sim.max_bounces. Both
-//   thresholds vanish with h (a genuine impact arrives at a speed that does not), so the limit
-//   h -> 0 is the same physics.
+//  Contact: h (4 g + (1 + mu_max) g m r^2 / I_min + 4 |w|^2 r), r the bounding radius: a bound on
+//   a corner's approach built up in one step of sustained contact, from gravity, from the angular
+//   acceleration that contact forces of order m g (normal plus friction) give at lever r, and
+//   from the spin's centripetal term. Under the gravity threshold a die sliding flat on a face
+//   rocks from corner to corner (friction pitches it; one corner touches per step), its corners
+//   arriving at ~6-8 g h, and a fast-spinning contact corner drifts in by ~w^2 r h per step:
+//   every step was a counted, bouncing impact, so the count grew like 1/h and fine steps hit
+//   sim.max_bounces. Both thresholds vanish with h (a genuine impact arrives at a speed that
+//   does not), so the limit h -> 0 is the same physics.
 enum class ImpactThreshold { Gravity, Contact };
 
 class FixedStepper {
@@ -39,7 +39,7 @@ class FixedStepper {
  private:
   const DieModel* m_;
   double h_, v_impact_, touch_tol_;
-  double v_spin_ = 0.0;  // Contact: 4 h r (the factor of |w|^2)
+  double v_spin_ = 0.0;  // Contact: 4 h r, the factor of |w|^2 in the threshold
 };
 
 enum class StepperExit { Settled, LiftOff, Unresolved };

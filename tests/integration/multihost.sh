@@ -108,7 +108,7 @@ case "$scenario" in
     in_ns "$ns_agg" "$bin" aggregate "$scene" --tosses "$n" --seed "$seed" --json --timeout 50 \
       > "$work/out.json" 2> "$work/agg.err" &
     agg=$!
-    pids+=($agg)
+    pids+=("$agg")
     # Mid-run by construction: the cut comes when the aggregator's own broadcast says 10% are in.
     in_ns "$ns_agg" "$inject" progress 0.1 40 || fail "the run never reached 10%, or finished before the cut"
     ip -n "$ns_br" link set p1 down
