@@ -123,10 +123,7 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   r.counts = res.counts;
   r.labels = model.face_labels;
   r.elapsed_s = res.elapsed_s;
-  if (a.json)
-    std::printf("%s\n", report_json(r).dump().c_str());
-  else
-    std::printf("%s", report_table(r).c_str());
+  print_report(r, a.json);
   return kExitOk;
 }
 

@@ -77,10 +77,7 @@ int replay_run(const ReplayArgs& a) {
   r.counts = res.counts;
   r.labels = res.labels;
   r.elapsed_s = elapsed;
-  if (a.json)
-    std::printf("%s\n", report_json(r).dump().c_str());
-  else
-    std::printf("%s", report_table(r).c_str());
+  print_report(r, a.json);
   return kExitOk;
 }
 

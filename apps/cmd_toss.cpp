@@ -72,10 +72,7 @@ int run_toss(const TossArgs& a) {
   r.counts = counts;
   r.labels = model.face_labels;
   r.elapsed_s = elapsed;
-  if (a.json)
-    std::printf("%s\n", report_json(r).dump().c_str());
-  else
-    std::printf("%s", report_table(r).c_str());
+  print_report(r, a.json);
   return kExitOk;
 }
 

@@ -77,4 +77,11 @@ std::string report_table(const RunReport& r) {
   return out;
 }
 
+void print_report(const RunReport& r, bool json) {
+  if (json)
+    std::printf("%s\n", report_json(r).dump().c_str());
+  else
+    std::printf("%s", report_table(r).c_str());
+}
+
 }  // namespace dicesim

@@ -27,5 +27,7 @@ struct RunReport {
 //  "elapsed_s", "tosses_per_s"} -- p and intervals over settled tosses, faces by label.
 nlohmann::json report_json(const RunReport& r);
 std::string report_table(const RunReport& r);
+// Prints the run on stdout: one JSON object (json) or the table.
+void print_report(const RunReport& r, bool json);
 
 }  // namespace dicesim

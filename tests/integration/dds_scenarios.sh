@@ -7,26 +7,9 @@
 # the build); the example subscriber is pointed at the same file with CYCLONEDDS_URI.
 set -euo pipefail
 
-if [ "${DICESIM_NETNS:-}" != "1" ]; then
-  if [ "$(id -u)" -ne 0 ]; then echo "SKIP: network namespaces need root"; exit 77; fi
-  exec unshare --net env DICESIM_NETNS=1 "$0" "$@"
-fi
-ip link set lo up
-ip link set lo multicast on
-ip route add 224.0.0.0/4 dev lo
-export LCM_DEFAULT_URL="udpm://239.255.76.67:7667?ttl=0"
+. "$(dirname "$0")/private_net.sh" dds "$@"
 
 bin=$1 sub=$2 inject=$3 scenario=$4
-src_dir=$(cd "$(dirname "$0")/../.." && pwd)
-cd "$src_dir"
-work=$(mktemp -d /tmp/dicesim-dds-XXXXXX)
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$work"
-}
-trap cleanup EXIT
 
 scene=scenes/paper/die1.toml
 seed=11

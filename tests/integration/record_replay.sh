@@ -11,26 +11,9 @@
 #            `dicesim record` hears the run again, and its log replays to the same JSON.
 set -euo pipefail
 
-if [ "${DICESIM_NETNS:-}" != "1" ]; then
-  if [ "$(id -u)" -ne 0 ]; then echo "SKIP: network namespaces need root"; exit 77; fi
-  exec unshare --net env DICESIM_NETNS=1 "$0" "$@"
-fi
-ip link set lo up
-ip link set lo multicast on
-ip route add 224.0.0.0/4 dev lo
-export LCM_DEFAULT_URL="udpm://239.255.76.67:7667?ttl=0"
+. "$(dirname "$0")/private_net.sh" rr "$@"
 
 bin=$1 scenario=$2
-src_dir=$(cd "$(dirname "$0")/../.." && pwd)
-cd "$src_dir"
-work=$(mktemp -d /tmp/dicesim-rr-XXXXXX)
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$work"
-}
-trap cleanup EXIT
 
 scene=scenes/paper/die1.toml
 seed=13
