@@ -5,7 +5,7 @@
 #include <unordered_set>
 
 #include "aggregator/target.hpp"
-#include "sim/statistics.hpp"
+#include "sim/study/statistics.hpp"
 
 namespace dicesim::agg {
 

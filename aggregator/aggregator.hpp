@@ -19,7 +19,7 @@
 #include "aggregator/interval_set.hpp"
 #include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
-#include "sim/monte_carlo.hpp"
+#include "sim/study/monte_carlo.hpp"
 
 namespace dicesim::agg {
 

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "sim/statistics.hpp"
+#include "sim/study/statistics.hpp"
 
 namespace dicesim::agg {
 

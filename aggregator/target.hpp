@@ -6,7 +6,7 @@
 
 #include <cstdint>
 
-#include "sim/monte_carlo.hpp"
+#include "sim/study/monte_carlo.hpp"
 
 namespace dicesim::agg {
 

@@ -3,7 +3,7 @@
 #include <string_view>
 
 #include "apps/commands.hpp"
-#include "sim/scene_error.hpp"
+#include "sim/scene/scene_error.hpp"
 
 namespace dicesim {
 

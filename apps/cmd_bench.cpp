@@ -7,8 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
-#include "sim/die_model.hpp"
-#include "sim/monte_carlo.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/study/monte_carlo.hpp"
 
 namespace dicesim {
 namespace {

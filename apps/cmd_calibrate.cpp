@@ -10,8 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
-#include "sim/restitution_fit.hpp"
-#include "sim/scene_error.hpp"
+#include "sim/study/restitution_fit.hpp"
+#include "sim/scene/scene_error.hpp"
 
 namespace dicesim {
 namespace {

@@ -4,7 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
-#include "sim/die_model.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/models/compile.hpp"
 
 namespace dicesim {
 namespace {

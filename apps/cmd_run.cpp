@@ -9,7 +9,8 @@
 #include "apps/worker_processes.hpp"
 #include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
-#include "sim/die_model.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/models/compile.hpp"
 
 namespace dicesim {
 namespace {

@@ -19,9 +19,9 @@
 #include "apps/progress.hpp"
 #include "apps/sweep_workers.hpp"
 #include "messages/wire.hpp"
-#include "sim/compare.hpp"
-#include "sim/scene_error.hpp"
-#include "sim/sweep.hpp"
+#include "sim/study/compare.hpp"
+#include "sim/scene/scene_error.hpp"
+#include "sim/study/sweep.hpp"
 
 namespace dicesim {
 namespace {

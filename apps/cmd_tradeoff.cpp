@@ -14,10 +14,11 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
-#include "sim/agreement.hpp"
-#include "sim/die_model.hpp"
-#include "sim/scene_error.hpp"
-#include "sim/toss.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/study/agreement.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/scene/scene_error.hpp"
+#include "sim/models/toss.hpp"
 
 namespace dicesim {
 namespace {

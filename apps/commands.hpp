@@ -10,7 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "sim/scene.hpp"
+#include "sim/scene/scene.hpp"
 
 namespace dicesim {
 

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "sim/statistics.hpp"
+#include "sim/study/statistics.hpp"
 
 namespace dicesim {
 namespace {

@@ -6,8 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "sim/die_model.hpp"
-#include "sim/monte_carlo.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/study/monte_carlo.hpp"
 
 namespace dicesim {
 

@@ -6,7 +6,7 @@
 
 #include "aggregator/session.hpp"
 #include "messages/run_spec.hpp"
-#include "sim/die_model.hpp"
+#include "sim/body/die_model.hpp"
 
 namespace dicesim {
 

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "apps/worker_processes.hpp"
-#include "sim/sweep.hpp"
+#include "sim/study/sweep.hpp"
 
 namespace dicesim {
 

@@ -4,12 +4,13 @@
 
 #include <vector>
 
-#include "sim/contact_stepper.hpp"
-#include "sim/die_model.hpp"
-#include "sim/friction_impact.hpp"
-#include "sim/initial_state.hpp"
-#include "sim/toss_random.hpp"
-#include "sim/toss.hpp"
+#include "sim/dynamics/contact_stepper.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/dynamics/friction_impact.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/models/initial_state.hpp"
+#include "sim/models/toss_random.hpp"
+#include "sim/models/toss.hpp"
 
 namespace {
 

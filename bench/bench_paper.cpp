@@ -2,11 +2,12 @@
 // COM 1 m, spin sd 18 rad/s). End-to-end throughput per thread and scaling: `dicesim bench`.
 #include <benchmark/benchmark.h>
 
-#include "sim/contact.hpp"
-#include "sim/die_model.hpp"
-#include "sim/flight.hpp"
-#include "sim/monte_carlo.hpp"
-#include "sim/toss.hpp"
+#include "sim/dynamics/contact.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/dynamics/flight.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/study/monte_carlo.hpp"
+#include "sim/models/toss.hpp"
 
 namespace {
 

@@ -15,7 +15,7 @@
 #include "aggregator/target.hpp"
 #include "logger/event_log.hpp"
 #include "logger/log.hpp"
-#include "sim/scene_error.hpp"
+#include "sim/scene/scene_error.hpp"
 
 namespace dicesim::eventlog {
 namespace {

@@ -16,8 +16,8 @@
 #include "aggregator/aggregator.hpp"
 #include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
-#include "sim/monte_carlo.hpp"
-#include "sim/toss.hpp"
+#include "sim/study/monte_carlo.hpp"
+#include "sim/models/toss.hpp"
 
 namespace dicesim::eventlog {
 

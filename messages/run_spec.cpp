@@ -12,7 +12,8 @@
 #include <toml++/toml.h>
 
 #include "messages/wire.hpp"
-#include "sim/scene_error.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/scene/scene_error.hpp"
 
 namespace dicesim::wire {
 namespace fs = std::filesystem;

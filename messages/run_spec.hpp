@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "dicesim_lcm/run_start.hpp"
-#include "sim/die_model.hpp"
+#include "sim/body/die_model.hpp"
 
 namespace dicesim::wire {
 

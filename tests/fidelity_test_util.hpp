@@ -5,8 +5,9 @@
 #include <cstdint>
 
 #include "scenes_for_tests.hpp"
-#include "sim/die_model.hpp"
-#include "sim/monte_carlo.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/study/monte_carlo.hpp"
 
 namespace dicesim::testing {
 

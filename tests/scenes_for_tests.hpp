@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "sim/scene.hpp"
+#include "sim/scene/scene.hpp"
 
 namespace dicesim::testing {
 

@@ -9,8 +9,8 @@
 #include "aggregator/aggregator.hpp"
 #include "aggregator/target.hpp"
 #include "messages/run_spec.hpp"
-#include "sim/monte_carlo.hpp"
-#include "sim/scene.hpp"
+#include "sim/study/monte_carlo.hpp"
+#include "sim/scene/scene.hpp"
 #include "sim/worker/worker.hpp"
 
 namespace {

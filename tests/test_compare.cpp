@@ -3,7 +3,7 @@
 
 #include <stdexcept>
 
-#include "sim/compare.hpp"
+#include "sim/study/compare.hpp"
 
 namespace dicesim {
 namespace {

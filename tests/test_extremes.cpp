@@ -8,8 +8,9 @@
 #include <vector>
 
 #include "fidelity_test_util.hpp"
-#include "sim/contact.hpp"
-#include "sim/toss.hpp"
+#include "sim/dynamics/contact.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/models/toss.hpp"
 
 using namespace dicesim;
 using namespace dicesim::testing;

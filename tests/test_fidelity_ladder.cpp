@@ -3,9 +3,10 @@
 #include <gtest/gtest.h>
 
 #include "fidelity_test_util.hpp"
-#include "sim/agreement.hpp"
-#include "sim/scene_error.hpp"
-#include "sim/statistics.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/study/agreement.hpp"
+#include "sim/scene/scene_error.hpp"
+#include "sim/study/statistics.hpp"
 
 using namespace dicesim;
 using namespace dicesim::testing;

@@ -4,10 +4,11 @@
 #include <cmath>
 
 #include "fidelity_test_util.hpp"
-#include "sim/contact.hpp"
-#include "sim/contact_stepper.hpp"
-#include "sim/friction_impact.hpp"
-#include "sim/toss_random.hpp"
+#include "sim/dynamics/contact.hpp"
+#include "sim/dynamics/contact_stepper.hpp"
+#include "sim/dynamics/friction_impact.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/models/toss_random.hpp"
 
 using namespace dicesim;
 using namespace dicesim::testing;

@@ -3,9 +3,9 @@
 
 #include <cmath>
 
-#include "sim/initial_state.hpp"
-#include "sim/statistics.hpp"
-#include "sim/toss_random.hpp"
+#include "sim/models/initial_state.hpp"
+#include "sim/study/statistics.hpp"
+#include "sim/models/toss_random.hpp"
 
 using namespace dicesim;
 

@@ -7,9 +7,10 @@
 
 #include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
-#include "sim/die_model.hpp"
-#include "sim/scene.hpp"
-#include "sim/scene_error.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/scene/scene.hpp"
+#include "sim/scene/scene_error.hpp"
 
 namespace w = dicesim::wire;
 

@@ -1,7 +1,7 @@
 // Mass properties of boxes cut by planes: exact values derived by hand in the comments, the
 // seed's three dice, the aluminium fraction that maximises the COM offset, clipping edge cases,
 // and random cuts bracketed by a grid.
-#include "sim/mass_properties.hpp"
+#include "sim/body/mass_properties.hpp"
 
 #include <gtest/gtest.h>
 

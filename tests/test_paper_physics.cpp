@@ -5,13 +5,14 @@
 #include <numeric>
 
 #include "scenes_for_tests.hpp"
-#include "sim/contact.hpp"
-#include "sim/die_model.hpp"
-#include "sim/flight.hpp"
-#include "sim/monte_carlo.hpp"
-#include "sim/statistics.hpp"
-#include "sim/toss.hpp"
-#include "sim/toss_random.hpp"
+#include "sim/dynamics/contact.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/dynamics/flight.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/study/monte_carlo.hpp"
+#include "sim/study/statistics.hpp"
+#include "sim/models/toss.hpp"
+#include "sim/models/toss_random.hpp"
 
 using namespace dicesim;
 using dicesim::testing::fair_scene;

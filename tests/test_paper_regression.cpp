@@ -9,8 +9,9 @@
 #include <array>
 #include <string>
 
-#include "sim/monte_carlo.hpp"
-#include "sim/scene.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/study/monte_carlo.hpp"
+#include "sim/scene/scene.hpp"
 
 namespace {
 

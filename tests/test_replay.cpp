@@ -20,9 +20,10 @@
 #include "logger/replay.hpp"
 #include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
-#include "sim/die_model.hpp"
-#include "sim/scene.hpp"
-#include "sim/toss.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/scene/scene.hpp"
+#include "sim/models/toss.hpp"
 
 namespace el = dicesim::eventlog;
 namespace w = dicesim::wire;

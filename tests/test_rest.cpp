@@ -5,9 +5,10 @@
 #include <cmath>
 
 #include "fidelity_test_util.hpp"
-#include "sim/contact_stepper.hpp"
-#include "sim/rest.hpp"
-#include "sim/toss.hpp"
+#include "sim/dynamics/contact_stepper.hpp"
+#include "sim/dynamics/rest.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/models/toss.hpp"
 
 using namespace dicesim;
 using namespace dicesim::testing;

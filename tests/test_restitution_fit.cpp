@@ -5,7 +5,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "sim/restitution_fit.hpp"
+#include "sim/study/restitution_fit.hpp"
 
 namespace dicesim {
 namespace {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "sim/scene.hpp"
-#include "sim/scene_error.hpp"
+#include "sim/scene/scene.hpp"
+#include "sim/scene/scene_error.hpp"
 
 namespace dicesim {
 namespace {

@@ -4,7 +4,7 @@
 #include <array>
 #include <cmath>
 
-#include "sim/statistics.hpp"
+#include "sim/study/statistics.hpp"
 
 using namespace dicesim;
 

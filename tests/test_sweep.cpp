@@ -7,10 +7,11 @@
 #include <unistd.h>
 
 #include "scenes_for_tests.hpp"
-#include "sim/die_model.hpp"
-#include "sim/initial_state.hpp"
-#include "sim/scene_error.hpp"
-#include "sim/sweep.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/models/initial_state.hpp"
+#include "sim/scene/scene_error.hpp"
+#include "sim/study/sweep.hpp"
 
 namespace dicesim {
 namespace {

@@ -1,7 +1,7 @@
 // Tests for the closed-form torque-free rotation (sim/torque_free.hpp): invariants, rotation
 // properties, agreement with an independent RK4 integration of Euler's equations, consistency of
 // omega with dR/dt, the bounds used by conservative advancement, and edge cases.
-#include "sim/torque_free.hpp"
+#include "sim/dynamics/torque_free.hpp"
 
 #include <gtest/gtest.h>
 

@@ -9,8 +9,8 @@
 #include <Eigen/Geometry>
 #include <lcm/lcm-cpp.hpp>
 
-#include "sim/scene_error.hpp"
-#include "sim/toss.hpp"
+#include "sim/scene/scene_error.hpp"
+#include "sim/models/toss.hpp"
 
 namespace dicesim::worker {
 namespace {

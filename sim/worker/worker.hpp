@@ -17,7 +17,7 @@
 
 #include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
-#include "sim/die_model.hpp"
+#include "sim/body/die_model.hpp"
 
 namespace dicesim::worker {
 

@@ -1,0 +1,51 @@
+// Between contacts: ballistic COM and torque-free rotation, both exact, and the search for the
+// next contact by conservative advancement (a step never passes a contact, at any spin).
+#pragma once
+
+#include "sim/body/die_model.hpp"
+#include "sim/math.hpp"
+#include "sim/dynamics/torque_free.hpp"
+
+namespace dicesim {
+
+// The die's state at one instant (world frame; R maps body -> world).
+struct RigidState {
+  Vec3 position = Vec3::Zero();  // COM
+  Vec3 velocity = Vec3::Zero();
+  Mat3 R = Mat3::Identity();
+  Vec3 omega = Vec3::Zero();
+};
+
+struct ContactSearch {
+  enum class Outcome { Contact, TimeLimit, IterationLimit } outcome = Outcome::TimeLimit;
+  double t = 0.0;   // time after the flight's start
+  int vertex = -1;  // the vertex that touches (Contact)
+  int iterations = 0;
+};
+
+class Flight {
+ public:
+  // Starts a flight from `s` (its omega sets the constant angular momentum).
+  Flight(const DieModel& model, const RigidState& s);
+
+  RigidState state(double t) const;
+
+  // First t in (0, t_limit] at which a vertex reaches the floor moving down.
+  ContactSearch next_contact(double t_limit) const;
+
+  const Vec3& angular_momentum() const { return rotation_.angular_momentum(); }
+
+ private:
+  const DieModel* model_;
+  Vec3 p0_, v0_;
+  TorqueFreeRotation rotation_;
+  double accel_bound_;  // bound on any vertex's downward acceleration
+  double contact_tol_;  // a vertex this close to the floor (m) counts as touching
+};
+
+// World inertia tensor of the die at orientation R: R diag(I) R^T.
+inline Mat3 world_inertia(const DieModel& m, const Mat3& R) {
+  return R * m.principal_moments.asDiagonal() * R.transpose();
+}
+
+}  // namespace dicesim

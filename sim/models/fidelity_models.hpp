@@ -1,0 +1,23 @@
+// The fidelity ladder's models behind sim::toss (sim/toss.cpp dispatches on DieModel::fidelity).
+// Each takes a valid initial state and a tiebreak in [0, 1) derived from the toss index, which
+// decides exact balances (PHYSICS.md, erratum 9: no hidden randomness).
+#pragma once
+
+#include "sim/body/die_model.hpp"
+#include "sim/dynamics/flight.hpp"
+#include "sim/models/toss.hpp"
+
+namespace dicesim {
+
+// `static`: the initial orientation, then the quasi-static roll (sim/rest.hpp). No dynamics.
+TossResult run_static(const DieModel& m, const RigidState& s, double tiebreak);
+
+// `impulse`: exact flight (sim/flight.hpp) between impacts with the friction impact law
+// (sim/friction_impact.hpp); sustained contact by fixed steps of m.contact_step
+// (sim/contact_stepper.hpp); ends when the die must rest (sim/rest.hpp).
+TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossProbe* probe);
+
+// `stepped`: the whole toss by fixed steps of m.step.
+TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossProbe* probe);
+
+}  // namespace dicesim

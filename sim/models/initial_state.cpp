@@ -1,0 +1,71 @@
+#include "sim/models/initial_state.hpp"
+
+#include <cmath>
+
+#include "sim/models/toss_random.hpp"
+
+namespace dicesim {
+
+Mat3 uniform_rotation(double u1, double u2, double u3) {
+  const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
+  const double t2 = 2.0 * kPi * u2, t3 = 2.0 * kPi * u3;
+  Quat q(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2), b * std::sin(t3));  // (w, x, y, z)
+  return q.normalized().toRotationMatrix();
+}
+
+Vec3 uniform_unit_vector(double u1, double u2) {
+  const double z = 2.0 * u1 - 1.0;
+  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  const double a = 2.0 * kPi * u2;
+  return {r * std::cos(a), r * std::sin(a), z};
+}
+
+static double draw(TossRandom& rng, const NormalScalar& d) {
+  return d.sd > 0.0 ? d.mean + d.sd * rng.normal() : d.mean;
+}
+
+InitialState draw_initial_state(const ThrowDef& thr, std::uint64_t seed, std::uint64_t toss) {
+  TossRandom rng(seed, toss);
+  InitialState s;
+
+  switch (thr.orientation.kind) {
+    case OrientationKind::Uniform: {
+      const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+      s.orientation = uniform_rotation(u1, u2, u3);
+      break;
+    }
+    case OrientationKind::EulerUniform: {
+      const double psi = 2.0 * kPi * rng.uniform(), theta = 2.0 * kPi * rng.uniform(),
+                   phi = 2.0 * kPi * rng.uniform();
+      s.orientation = euler_zxz(psi, theta, phi);
+      break;
+    }
+    case OrientationKind::Fixed: {
+      const Vec3 e = thr.orientation.euler_deg * (kPi / 180.0);
+      s.orientation = euler_zxz(e.x(), e.y(), e.z());
+      break;
+    }
+  }
+
+  s.com_position = Vec3(0.0, 0.0, draw(rng, thr.height));
+  for (int k = 0; k < 3; ++k) s.velocity[k] = draw(rng, {thr.velocity.mean[k], thr.velocity.sd[k]});
+
+  switch (thr.spin.kind) {
+    case SpinKind::Normal:
+      for (int k = 0; k < 3; ++k) s.omega[k] = draw(rng, {thr.spin.components.mean[k], thr.spin.components.sd[k]});
+      break;
+    case SpinKind::RandomAxis: {
+      const double u1 = rng.uniform(), u2 = rng.uniform();
+      s.omega = uniform_unit_vector(u1, u2) * draw(rng, thr.spin.magnitude);
+      break;
+    }
+    case SpinKind::OctantAxis: {
+      Vec3 axis(rng.uniform(), rng.uniform(), rng.uniform());  // each in (0, 1): never all zero
+      s.omega = axis.normalized() * draw(rng, thr.spin.magnitude);
+      break;
+    }
+  }
+  return s;
+}
+
+}  // namespace dicesim

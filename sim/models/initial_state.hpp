@@ -1,0 +1,25 @@
+// A toss's initial state, drawn from the scene's throw distributions by (seed, toss index).
+#pragma once
+
+#include <cstdint>
+
+#include "sim/math.hpp"
+#include "sim/scene/scene.hpp"
+
+namespace dicesim {
+
+struct InitialState {
+  Vec3 com_position = Vec3::Zero();  // world (m); x, y = 0, z = COM height
+  Vec3 velocity = Vec3::Zero();      // world (m/s)
+  Mat3 orientation = Mat3::Identity();  // geometric frame -> world
+  Vec3 omega = Vec3::Zero();         // world angular velocity (rad/s)
+};
+
+// Draws in a fixed order (orientation, height, velocity, spin) from TossRandom(seed, toss).
+InitialState draw_initial_state(const ThrowDef& thr, std::uint64_t seed, std::uint64_t toss);
+
+// Orientation helpers (exposed for tests).
+Mat3 uniform_rotation(double u1, double u2, double u3);  // Shoemake: Haar measure on SO(3)
+Vec3 uniform_unit_vector(double u1, double u2);
+
+}  // namespace dicesim

@@ -1,0 +1,27 @@
+// `stepped`: fixed-step integration of flight, impacts, sliding, rolling and tipping until rest.
+#include "sim/dynamics/contact_stepper.hpp"
+#include "sim/models/fidelity_models.hpp"
+#include "sim/dynamics/rest.hpp"
+
+namespace dicesim {
+
+TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossProbe* probe) {
+  TossResult r;
+  double t = 0.0;
+  int impacts = 0;
+  const StepperOutcome o = run_fixed_steps(m, s, t, impacts, m.step, tiebreak, /*allow_liftoff=*/false,
+                                           ImpactThreshold::Contact);
+  if (probe) probe->flights += 1;
+  r.bounces = impacts;
+  r.t_end = t;
+  if (o.exit != StepperExit::Settled) {
+    r.status = TossStatus::Unresolved;
+    return r;
+  }
+  r.status = TossStatus::Settled;
+  r.face_index = opposite_face(o.face_down);
+  r.face = m.face_labels[r.face_index];
+  return r;
+}
+
+}  // namespace dicesim

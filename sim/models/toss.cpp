@@ -1,0 +1,146 @@
+#include "sim/models/toss.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include <cstring>
+
+#include <Random123/philox.h>
+
+#include "sim/dynamics/contact.hpp"
+#include "sim/models/fidelity_models.hpp"
+#include "sim/body/outcome.hpp"
+
+namespace dicesim {
+
+const char* to_string(TossStatus s) {
+  switch (s) {
+    case TossStatus::Settled: return "settled";
+    case TossStatus::Unresolved: return "unresolved";
+    case TossStatus::Invalid: return "invalid";
+  }
+  return "?";
+}
+
+RigidState to_body_state(const DieModel& m, const InitialState& init) {
+  RigidState s;
+  s.position = init.com_position;
+  s.velocity = init.velocity;
+  s.R = init.orientation * m.geo_to_body.transpose();
+  s.omega = init.omega;
+  return s;
+}
+
+namespace {
+
+bool starts_valid(const DieModel& m, const RigidState& s) {
+  if (!s.position.allFinite() || !s.velocity.allFinite() || !s.omega.allFinite() || !s.R.allFinite()) return false;
+  const double tol = 1e-9 * m.bounding_radius;
+  for (const Vec3& v : m.vertices)
+    if (s.position.z() + s.R.row(2).dot(v) < -tol) return false;
+  return true;
+}
+
+// Re-orthonormalise between flights so that rounding cannot accumulate over many bounces.
+Mat3 orthonormal(const Mat3& R) { return Quat(R).normalized().toRotationMatrix(); }
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+TossResult run_paper(const DieModel& m, RigidState s, TossProbe* probe) {
+  const bool timing = probe && probe->timing;
+  Clock::time_point t0;
+  TossResult r;
+  double t_now = 0.0;
+  double last_impact = -1.0;
+  int zeno_run = 0;
+  for (;;) {
+    if (timing) t0 = Clock::now();
+    const Flight flight(m, s);
+    const ContactSearch c = flight.next_contact(m.max_time - t_now);
+    if (probe) {
+      probe->search_iterations += static_cast<std::uint64_t>(c.iterations);
+      ++probe->flights;
+      if (timing) probe->flight_s += seconds_since(t0);
+    }
+    if (c.outcome != ContactSearch::Outcome::Contact) {
+      r.status = TossStatus::Unresolved;
+      r.t_end = t_now + c.t;
+      return r;
+    }
+    if (timing) t0 = Clock::now();
+    t_now += c.t;
+    RigidState before = flight.state(c.t);
+    before.R = orthonormal(before.R);
+    s = before;
+    const Impact imp = apply_vertex_impact(m, s, c.vertex);
+    ++r.bounces;
+    if (probe && probe->trace) probe->trace->push_back({r.bounces, t_now, before, s, c.vertex, imp.impulse});
+    if (timing) probe->impact_s += seconds_since(t0);
+
+    // The seed's rule: the toss is over when the COM's rebound speed is below the threshold.
+    if (s.velocity.z() < m.stop_speed) {
+      r.status = TossStatus::Settled;
+      r.face_index = top_face_index(m, s.R);
+      r.face = m.face_labels[r.face_index];
+      r.t_end = t_now;
+      return r;
+    }
+    zeno_run = (last_impact >= 0.0 && t_now - last_impact < kZenoInterval) ? zeno_run + 1 : 0;
+    last_impact = t_now;
+    if (zeno_run >= kZenoRun || r.bounces >= m.max_bounces) {
+      r.status = TossStatus::Unresolved;
+      r.t_end = t_now;
+      return r;
+    }
+  }
+}
+
+// The toss's tiebreak for exact balances, in [0, 1): Philox keyed by the seed, on a counter word
+// the throw's own draws never use, so the throw is unchanged.
+double tiebreak_of(std::uint64_t seed, std::uint64_t index) {
+  r123::Philox4x32 gen;
+  const r123::Philox4x32::key_type key = {{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32)}};
+  const r123::Philox4x32::ctr_type ctr = {{static_cast<std::uint32_t>(index), static_cast<std::uint32_t>(index >> 32), 0u, 0xD1CEu}};
+  const auto out = gen(ctr, key);
+  return static_cast<double>((static_cast<std::uint64_t>(out.v[0]) << 21) ^ out.v[1]) * 0x1.0p-53;
+}
+
+// Without a toss index (replays, tests): a hash of the initial state, so still deterministic.
+double tiebreak_of(const InitialState& init) {
+  std::uint64_t h = 0x9E3779B97F4A7C15ull;
+  const double parts[] = {init.com_position.z(), init.velocity.x(), init.velocity.y(), init.velocity.z(),
+                          init.omega.x(), init.omega.y(), init.omega.z(), init.orientation(0, 0), init.orientation(1, 2)};
+  for (double d : parts) {
+    std::uint64_t b;
+    std::memcpy(&b, &d, sizeof b);
+    h = (h ^ b) * 0x100000001B3ull;
+    h ^= h >> 29;
+  }
+  return static_cast<double>(h >> 11) * 0x1.0p-53;
+}
+
+TossResult run(const DieModel& m, const InitialState& init, double tiebreak, TossProbe* probe) {
+  const RigidState s = to_body_state(m, init);
+  if (!starts_valid(m, s)) return TossResult{};  // status Invalid
+  switch (m.fidelity) {
+    case Fidelity::Paper: return run_paper(m, s, probe);
+    case Fidelity::Static: return run_static(m, s, tiebreak);
+    case Fidelity::Impulse: return run_impulse(m, s, tiebreak, probe);
+    case Fidelity::Stepped: return run_stepped(m, s, tiebreak, probe);
+    case Fidelity::Auto: break;  // resolved by compile(); never reaches a toss
+  }
+  return TossResult{};
+}
+
+}  // namespace
+
+TossResult toss_from(const DieModel& m, const InitialState& init, TossProbe* probe) {
+  return run(m, init, tiebreak_of(init), probe);
+}
+
+TossResult toss(const DieModel& m, std::uint64_t seed, std::uint64_t index, TossProbe* probe) {
+  return run(m, draw_initial_state(m.throw_, seed, index), tiebreak_of(seed, index), probe);
+}
+
+}  // namespace dicesim

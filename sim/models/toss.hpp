@@ -1,0 +1,62 @@
+// One toss, top to bottom: draw the throw, fly, strike, repeat, read the face.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "sim/body/die_model.hpp"
+#include "sim/dynamics/flight.hpp"
+#include "sim/models/initial_state.hpp"
+
+namespace dicesim {
+
+enum class TossStatus : std::uint8_t {
+  Settled = 0,     // ended by the fidelity's rule; face is the answer
+  Unresolved = 1,  // hit the bounce or time cap, or chattered (Zeno): no answer, counted
+  Invalid = 2,     // the drawn initial state is impossible (die below the floor, non-finite)
+};
+const char* to_string(TossStatus s);
+
+struct TossResult {
+  int face = 0;        // face label (settled tosses), else 0
+  int face_index = -1; // 0..5 in +x, -x, +y, -y, +z, -z order, else -1
+  TossStatus status = TossStatus::Invalid;
+  int bounces = 0;
+  double t_end = 0.0;  // simulated time at the end (s)
+};
+
+// One impact, for traces and replays.
+struct BounceRecord {
+  int bounce = 0;      // 1-based
+  double t = 0.0;      // since release (s)
+  RigidState before;   // at the instant of contact
+  RigidState after;    // right after the impulse
+  int vertex = -1;
+  double impulse = 0.0;
+};
+
+// Optional instruments for one or many tosses (null in the hot path: nothing is recorded).
+struct TossProbe {
+  std::vector<BounceRecord>* trace = nullptr;  // every impact appended
+  bool timing = false;                         // accumulate the split below (costs ~5%)
+  double flight_s = 0.0;                       // contact searches and flight set-up
+  double impact_s = 0.0;                       // impulses and the stop rule
+  std::uint64_t search_iterations = 0;         // conservative-advancement steps
+  std::uint64_t flights = 0;
+};
+
+// Chatter guard (`paper`): this many impacts in a row, each less than kZenoInterval after the
+// previous one, mean the die is pivoting on a corner and will never satisfy the stop rule.
+inline constexpr double kZenoInterval = 1e-7;  // s
+inline constexpr int kZenoRun = 8;
+
+// Toss number `index` of a run with `seed`.
+TossResult toss(const DieModel& m, std::uint64_t seed, std::uint64_t index, TossProbe* probe = nullptr);
+
+// The same from a given initial state (tests, replays of special cases).
+TossResult toss_from(const DieModel& m, const InitialState& init, TossProbe* probe = nullptr);
+
+// The initial state in the model's body frame (COM at init.com_position).
+RigidState to_body_state(const DieModel& m, const InitialState& init);
+
+}  // namespace dicesim

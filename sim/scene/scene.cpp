@@ -1,0 +1,552 @@
+// Scene files: TOML -> (extends chain, --set overrides) -> one merged tree -> validated SceneDef.
+// Defaults come from the member initialisers in scene.hpp; this file only reads what a scene states.
+#include "sim/scene/scene.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <utility>
+
+#include <toml++/toml.h>
+
+#include "sim/scene/scene_error.hpp"
+
+namespace dicesim {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// The source name of every value that came from an override: the scene it overrides, marked.
+std::string set_origin(const std::string& scene) { return scene + " (--set)"; }
+
+// ---- Showing keys and values in error messages ------------------------------------------------
+
+// A TOML basic string, so that any text (also a bare --set value) round-trips through the parser.
+std::string toml_string(std::string_view s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04X", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      out += buf;
+    } else {
+      out += c;
+    }
+  }
+  return out + '"';
+}
+
+bool is_bare_key(std::string_view k) {
+  if (k.empty()) return false;
+  for (char c : k)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) return false;
+  return true;
+}
+
+// Face keys read alike ("+x", "-x") when a leading '-' is quoted too, which TOML allows.
+std::string key_text(std::string_view k) {
+  return is_bare_key(k) && k.front() != '-' ? std::string(k) : toml_string(k);
+}
+
+std::string child_path(const std::string& parent, std::string_view key) {
+  return parent.empty() ? key_text(key) : parent + "." + key_text(key);
+}
+
+// The value as the user wrote it (TOML syntax), for "key = value" in messages.
+std::string describe(const toml::node& n) {
+  if (const auto* s = n.as_string()) return toml_string(s->get());
+  std::string out;
+  if (const auto* a = n.as_array()) {
+    for (const auto& e : *a) out += (out.empty() ? "" : ", ") + describe(e);
+    return "[" + out + "]";
+  }
+  if (const auto* t = n.as_table()) {
+    for (const auto& [k, v] : *t) out += (out.empty() ? "" : ", ") + key_text(k.str()) + " = " + describe(v);
+    return "{" + out + "}";
+  }
+  if (const auto* f = n.as_floating_point()) {
+    // Shortest text that reads back as the same double (0.03, not 0.029999999999999999).
+    char buf[64];
+    std::string s(buf, std::to_chars(buf, buf + sizeof buf, f->get()).ptr);
+    if (std::isfinite(f->get()) && s.find_first_of(".e") == std::string::npos) s += ".0";
+    return s;
+  }
+  std::ostringstream os;
+  n.visit([&](const auto& v) { os << v; });
+  return os.str();
+}
+
+// 1e6 rather than 1e+06: ranges in messages read like the README.
+std::string num_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  std::string s = buf;
+  if (auto e = s.find("e+"); e != std::string::npos) {
+    s.erase(e + 1, 1);
+    while (s.size() > e + 2 && s[e + 1] == '0') s.erase(e + 1, 1);
+  }
+  return s;
+}
+
+// The closed or open interval a number must lie in, and its unit, as the message shows it.
+struct Range {
+  double lo = -kInf, hi = kInf;
+  bool lo_open = false, hi_open = false;
+  const char* unit = "";
+
+  bool contains(double v) const {
+    return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+  }
+  bool bounded() const { return std::isfinite(lo) || std::isfinite(hi); }
+  // Follows "must be a number": " in (0, 1e6] kg/m^3", " >= 0 m/s", " (deg)" or "".
+  std::string text() const {
+    if (!bounded()) return *unit ? std::string(" (") + unit + ")" : "";
+    std::string s;
+    if (std::isfinite(lo) && std::isfinite(hi))
+      s = std::string(" in ") + (lo_open ? "(" : "[") + num_text(lo) + ", " + num_text(hi) + (hi_open ? ")" : "]");
+    else if (std::isfinite(lo))
+      s = std::string(lo_open ? " > " : " >= ") + num_text(lo);
+    else
+      s = std::string(hi_open ? " < " : " <= ") + num_text(hi);
+    return *unit ? s + " " + unit : s;
+  }
+};
+
+constexpr Range kDensity{.lo = 0, .hi = 1e6, .lo_open = true, .unit = "kg/m^3"};
+constexpr Range kRestitution{.lo = 0, .hi = 1};
+constexpr Range kFriction{.lo = 0, .hi = 10};
+constexpr Range kEdge{.lo = 0, .hi = 100, .lo_open = true, .unit = "m"};
+constexpr Range kLength{.unit = "m"};
+constexpr Range kLengthSd{.lo = 0, .unit = "m"};
+constexpr Range kSpeed{.unit = "m/s"};
+constexpr Range kSpeedSd{.lo = 0, .unit = "m/s"};
+constexpr Range kSpin{.unit = "rad/s"};
+constexpr Range kSpinSd{.lo = 0, .unit = "rad/s"};
+constexpr Range kAngle{.unit = "deg"};
+constexpr Range kGravity{.lo = 0, .hi = 1000, .lo_open = true, .unit = "m/s^2"};
+constexpr Range kStopSpeed{.lo = 0, .hi = 100, .unit = "m/s"};
+constexpr Range kMaxTime{.lo = 0, .hi = 1e6, .lo_open = true, .unit = "s"};
+constexpr Range kStep{.lo = 1e-7, .hi = 1e-2, .unit = "s"};
+constexpr Range kAnyNumber{};
+
+// Names a key may take, and what each means.
+template <class T, std::size_t N>
+using Names = std::array<std::pair<std::string_view, T>, N>;
+
+constexpr Names<OrientationKind, 3> kOrientationKinds{{
+    {"uniform", OrientationKind::Uniform},
+    {"euler-uniform", OrientationKind::EulerUniform},
+    {"fixed", OrientationKind::Fixed},
+}};
+// "fixed" spin is the normal kind with sd 0: the sampler needs no extra case.
+constexpr Names<SpinKind, 4> kSpinKinds{{
+    {"normal", SpinKind::Normal},
+    {"random-axis", SpinKind::RandomAxis},
+    {"octant-axis", SpinKind::OctantAxis},
+    {"fixed", SpinKind::Normal},
+}};
+constexpr Names<bool, 2> kHeightKinds{{{"normal", false}, {"fixed", true}}};  // value: is fixed
+
+// ---- Reading one table -----------------------------------------------------------------------
+
+// Reads the keys of one TOML table with validation. Every key asked for becomes a known key
+// (whether present or not), so finish() can name the allowed keys without a second list.
+class Reader {
+ public:
+  // `node` may be absent (all defaults); when present it must be a table.
+  Reader(const toml::node* node, std::string path, const std::string& origin)
+      : path_(std::move(path)), origin_(&origin) {
+    if (node && !(table_ = node->as_table())) fail(node, path_, "must be a table");
+  }
+
+  const std::string& path() const { return path_; }
+  const std::string& origin() const { return *origin_; }
+  const toml::table* table() const { return table_; }
+  std::string path_of(std::string_view key) const { return child_path(path_, key); }
+
+  // The node under `key`, or nullptr.
+  const toml::node* get(std::string_view key) {
+    if (std::find(known_.begin(), known_.end(), key) == known_.end()) known_.emplace_back(key);
+    return table_ ? table_->get(key) : nullptr;
+  }
+
+  Reader sub(std::string_view key) { return Reader(get(key), path_of(key), *origin_); }
+
+  // Errors name the file the value was written in: this scene, a scene it extends, or "SCENE (--set)".
+  [[noreturn]] void fail(const toml::node* n, const std::string& key, const std::string& allowed) const {
+    const std::string file = n && n->source().path ? *n->source().path : *origin_;
+    throw SceneError(file, key, n ? describe(*n) : "", allowed);
+  }
+  // A required key is absent: blame the file of the table that lacks it.
+  [[noreturn]] void fail_missing(std::string_view key, const std::string& allowed) const {
+    const bool known = table_ && table_->source().path;
+    throw SceneError(known ? *table_->source().path : *origin_, path_of(key), "", "required: " + allowed);
+  }
+
+  double number(const toml::node& n, const std::string& key, const Range& r) const {
+    const std::optional<double> v = n.is_integer() || n.is_floating_point() ? n.value<double>() : std::nullopt;
+    if (!v) fail(&n, key, "must be a number" + r.text());
+    if (!std::isfinite(*v)) fail(&n, key, "must be finite: a number" + r.text());
+    if (!r.contains(*v)) fail(&n, key, "must be a number" + r.text());
+    return *v;
+  }
+
+  std::optional<double> number(std::string_view key, const Range& r) {
+    const toml::node* n = get(key);
+    return n ? std::optional(number(*n, path_of(key), r)) : std::nullopt;
+  }
+  double number(std::string_view key, const Range& r, double fallback) {
+    return number(key, r).value_or(fallback);
+  }
+
+  // Three numbers; `scalar_ok`: a single number stands for all three.
+  Vec3 vec3(std::string_view key, const Range& r, const Vec3& fallback, bool scalar_ok) {
+    const toml::node* n = get(key);
+    if (!n) return fallback;
+    const std::string k = path_of(key);
+    if (scalar_ok && (n->is_integer() || n->is_floating_point())) return Vec3::Constant(number(*n, k, r));
+    const auto* a = n->as_array();
+    if (!a || a->size() != 3)
+      fail(n, k, std::string(scalar_ok ? "must be a number or an array of 3 numbers" : "must be an array of 3 numbers") +
+                     (r.bounded() ? ", each" + r.text() : r.text()));
+    Vec3 v;
+    for (int i = 0; i < 3; ++i) v[i] = number(*a->get(i), k + "[" + std::to_string(i) + "]", r);
+    return v;
+  }
+
+  std::optional<std::string> string(std::string_view key) {
+    const toml::node* n = get(key);
+    if (!n) return std::nullopt;
+    if (!n->is_string()) fail(n, path_of(key), "must be a string");
+    return n->as_string()->get();
+  }
+
+  int integer(std::string_view key, long long lo, long long hi, int fallback) {
+    const toml::node* n = get(key);
+    if (!n) return fallback;
+    const std::string range = " in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    if (!n->is_integer()) fail(n, path_of(key), "must be an integer" + range);
+    const long long v = n->as_integer()->get();
+    if (v < lo || v > hi) fail(n, path_of(key), "must be an integer" + range);
+    return static_cast<int>(v);
+  }
+
+  // One of `names`; the entry of `fallback` when the key is absent.
+  template <class T, std::size_t N>
+  const std::pair<std::string_view, T>& choice(std::string_view key, const Names<T, N>& names, T fallback) {
+    const std::optional<std::string> s = string(key);
+    for (const auto& entry : names)
+      if (s ? entry.first == *s : entry.second == fallback) return entry;
+    std::string allowed;
+    for (const auto& entry : names) allowed += (allowed.empty() ? "" : ", ") + toml_string(entry.first);
+    allowed = "must be one of: " + allowed;
+    fail(get(key), path_of(key), allowed);
+  }
+
+  // Elements of the array of tables under `key` (e.g. [[die.regions]]), each as a Reader.
+  std::vector<Reader> tables(std::string_view key) {
+    const toml::node* n = get(key);
+    std::vector<Reader> out;
+    if (!n) return out;
+    const auto* a = n->as_array();
+    if (!a) fail(n, path_of(key), "must be an array of tables");
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const std::string k = path_of(key) + "[" + std::to_string(i) + "]";
+      if (!a->get(i)->is_table()) fail(a->get(i), k, "must be a table");
+      out.emplace_back(a->get(i), k, *origin_);
+    }
+    return out;
+  }
+
+  // Typos must not pass silently: every key present must be one that was asked for.
+  void finish() const {
+    if (!table_) return;
+    for (const auto& [k, v] : *table_) {
+      if (std::find(known_.begin(), known_.end(), k.str()) != known_.end()) continue;
+      std::string allowed;
+      for (const auto& a : known_) allowed += (allowed.empty() ? "" : ", ") + key_text(a);
+      const std::string where = path_.empty() ? "at the top level" : "in [" + path_ + "]";
+      fail(&v, path_of(k.str()), "unknown key '" + std::string(k.str()) + "' " + where + "; allowed: " + allowed);
+    }
+  }
+
+ private:
+  const toml::table* table_ = nullptr;
+  std::string path_;
+  const std::string* origin_;
+  std::vector<std::string> known_;
+};
+
+// ---- Sections --------------------------------------------------------------------------------
+
+void read_materials(Reader all, std::map<std::string, MaterialDef>& out) {
+  if (!all.table()) return;
+  for (const auto& [name, value] : *all.table()) {  // names are free: no finish() at this level
+    Reader m(&value, all.path_of(name.str()), all.origin());
+    if (!is_bare_key(name.str())) m.fail(&value, m.path(), "material names must match [A-Za-z0-9_-]+");
+    MaterialDef def;
+    def.density = m.number("density", kDensity, def.density);
+    def.restitution = m.number("restitution", kRestitution, def.restitution);
+    def.friction = m.number("friction", kFriction, def.friction);
+    m.finish();
+    out[std::string(name.str())] = def;
+  }
+}
+
+// A material name that must be defined under [materials].
+std::string material_ref(Reader& r, const std::map<std::string, MaterialDef>& materials) {
+  std::string defined;
+  for (const auto& [name, m] : materials) defined += (defined.empty() ? "" : ", ") + name;
+  if (defined.empty()) defined = "(none)";
+  const std::optional<std::string> name = r.string("material");
+  if (!name) r.fail_missing("material", "the name of a material; defined: " + defined);
+  if (!materials.count(*name)) r.fail(r.get("material"), r.path_of("material"), "must name a material in [materials]; defined: " + defined);
+  return *name;
+}
+
+void read_die(Reader die, const std::map<std::string, MaterialDef>& materials, DieDef& def) {
+  def.size = die.vec3("size", kEdge, def.size, true);
+  def.base_material = material_ref(die, materials);
+  for (Reader& region : die.tables("regions")) {
+    RegionDef rd;
+    rd.material = material_ref(region, materials);
+    for (Reader& cut : region.tables("cuts")) {
+      HalfSpace h;
+      const toml::node* normal = cut.get("normal");
+      if (!normal) cut.fail_missing("normal", "an array of 3 numbers, not all 0");
+      h.normal = cut.vec3("normal", kAnyNumber, h.normal, false);
+      if (h.normal.isZero(0.0)) cut.fail(normal, cut.path_of("normal"), "must be an array of 3 numbers, not all 0");
+      h.offset = cut.number("offset", kLength, h.offset);
+      cut.finish();
+      rd.half_spaces.push_back(h);
+    }
+    region.finish();
+    def.regions.push_back(std::move(rd));
+  }
+
+  Reader faces = die.sub("faces");
+  for (std::size_t i = 0; i < 6; ++i) def.face_labels[i] = faces.integer(kFaceDirNames[i], 1, 99, def.face_labels[i]);
+  for (std::size_t i = 0; i < 6; ++i)
+    for (std::size_t j = i + 1; j < 6; ++j) {
+      if (def.face_labels[i] != def.face_labels[j]) continue;
+      // Blame the face the scene states (the other one may be a default).
+      const std::size_t k = faces.get(kFaceDirNames[j]) ? j : i;
+      faces.fail(faces.get(kFaceDirNames[k]), faces.path_of(kFaceDirNames[k]),
+                 std::string("face labels must be distinct: ") + kFaceDirNames[i] + " and " + kFaceDirNames[j] +
+                     " are both " + std::to_string(def.face_labels[i]));
+    }
+  faces.finish();
+  die.finish();
+}
+
+void read_throw(Reader th, ThrowDef& def) {
+  Reader orientation = th.sub("orientation");
+  def.orientation.kind = orientation.choice("kind", kOrientationKinds, def.orientation.kind).second;
+  def.orientation.euler_deg = orientation.vec3("euler_deg", kAngle, def.orientation.euler_deg, false);
+  orientation.finish();
+
+  Reader height = th.sub("height");
+  const bool height_fixed = height.choice("kind", kHeightKinds, false).second;
+  def.height.mean = height.number("mean", kLength, def.height.mean);
+  def.height.sd = height.number("sd", kLengthSd, def.height.sd);
+  if (height_fixed) def.height.sd = 0.0;
+  height.finish();
+
+  Reader velocity = th.sub("velocity");
+  def.velocity.mean = velocity.vec3("mean", kSpeed, def.velocity.mean, true);
+  def.velocity.sd = velocity.vec3("sd", kSpeedSd, def.velocity.sd, true);
+  velocity.finish();
+
+  Reader spin = th.sub("spin");
+  const auto& [kind_name, kind] = spin.choice("kind", kSpinKinds, def.spin.kind);
+  def.spin.kind = kind;
+  if (kind == SpinKind::Normal) {
+    def.spin.components.mean = spin.vec3("mean", kSpin, def.spin.components.mean, true);
+    def.spin.components.sd = spin.vec3("sd", kSpinSd, def.spin.components.sd, true);
+    if (kind_name == "fixed") def.spin.components.sd = Vec3::Zero();
+  } else {
+    def.spin.magnitude.mean = spin.number("mean", kSpin, def.spin.magnitude.mean);
+    def.spin.magnitude.sd = spin.number("sd", kSpinSd, def.spin.magnitude.sd);
+  }
+  spin.finish();
+  th.finish();
+}
+
+void read_floor(Reader floor, FloorDef& def) {
+  if (auto e = floor.number("restitution", kRestitution)) def.restitution = e;
+  floor.finish();
+}
+
+void read_sim(Reader sim, SimDef& def) {
+  if (const std::optional<std::string> f = sim.string("fidelity")) {
+    const std::optional<Fidelity> parsed = parse_fidelity(*f);
+    if (!parsed) sim.fail(sim.get("fidelity"), sim.path_of("fidelity"), std::string("must be ") + kFidelityChoices);
+    def.fidelity = *parsed;
+  }
+  def.gravity = sim.number("gravity", kGravity, def.gravity);
+  def.stop_speed = sim.number("stop_speed", kStopSpeed, def.stop_speed);
+  def.max_bounces = sim.integer("max_bounces", 1, 10'000'000, def.max_bounces);
+  def.max_time = sim.number("max_time", kMaxTime, def.max_time);
+  def.step = sim.number("step", kStep, def.step);
+  def.contact_step = sim.number("contact_step", kStep, def.contact_step);
+  sim.finish();
+}
+
+SceneDef build(const toml::table& tree, const std::string& origin, const std::string& default_name) {
+  SceneDef s = default_scene_def();
+  Reader top(&tree, "", origin);
+  s.name = top.string("name").value_or(default_name);
+  if (s.name.empty()) top.fail(top.get("name"), "name", "must be a non-empty string");
+  top.get("extends");  // already resolved; listed so that it shows among the allowed keys
+  read_materials(top.sub("materials"), s.materials);
+  read_die(top.sub("die"), s.materials, s.die);
+  read_throw(top.sub("throw"), s.throw_);
+  read_floor(top.sub("floor"), s.floor);
+  read_sim(top.sub("sim"), s.sim);
+  top.finish();
+  return s;
+}
+
+// ---- The merged tree: files, extends, overrides ----------------------------------------------
+
+// Deep merge: tables merge key by key, anything else (arrays too) replaces. Nodes are moved, which
+// keeps their source (file, line), so an error still names the file the value was written in.
+void merge(toml::table& into, toml::table&& from) {
+  for (auto&& [k, v] : from) {
+    toml::node* dst = into.get(k.str());
+    if (dst && dst->is_table() && v.is_table())
+      merge(*dst->as_table(), std::move(*v.as_table()));
+    else
+      into.insert_or_assign(k, std::move(v));
+  }
+}
+
+toml::table parse_toml(std::string_view text, const std::string& source) {
+  try {
+    return toml::parse(text, std::string_view(source));
+  } catch (const toml::parse_error& e) {
+    const auto& at = e.source().begin;
+    throw SceneError(source, "", "", "TOML syntax error at line " + std::to_string(at.line) + ", column " +
+                                         std::to_string(at.column) + ": " + std::string(e.description()));
+  }
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in || fs::is_directory(path)) throw SceneError(path, "", "", "cannot open scene file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+struct ChainLink {
+  fs::path id;     // canonical: what a cycle is detected on
+  fs::path shown;  // as the user would write it
+};
+
+toml::table load_tree(const fs::path& path, std::vector<ChainLink>& chain);
+
+// If `tree` extends another scene: that scene's tree (recursively) with `tree` merged on top.
+// The base's `name` is dropped: a derived scene is named by its own file.
+toml::table resolve_extends(toml::table tree, const std::string& file, const fs::path& dir, std::vector<ChainLink>& chain) {
+  const toml::node* ext = tree.get("extends");
+  if (!ext) return tree;
+  if (!ext->is_string()) throw SceneError(file, "extends", describe(*ext), "must be a string: a scene path relative to this file");
+  const fs::path base = (dir / ext->as_string()->get()).lexically_normal();
+  if (!fs::is_regular_file(base))
+    throw SceneError(file, "extends", describe(*ext), "cannot open scene file '" + base.string() + "'");
+  const fs::path id = fs::weakly_canonical(base);
+  for (const ChainLink& link : chain)
+    if (link.id == id) {
+      std::string cycle;
+      for (const ChainLink& l : chain) cycle += l.shown.string() + " -> ";
+      throw SceneError(file, "extends", describe(*ext), "extends cycle: " + cycle + base.string());
+    }
+  chain.push_back({id, base});
+  toml::table merged = load_tree(base, chain);
+  chain.pop_back();
+  merged.erase("name");
+  tree.erase("extends");
+  merge(merged, std::move(tree));
+  return merged;
+}
+
+toml::table load_tree(const fs::path& path, std::vector<ChainLink>& chain) {
+  return resolve_extends(parse_toml(read_text(path.string()), path.string()), path.string(), path.parent_path(), chain);
+}
+
+std::string trim(std::string_view s) {
+  const auto b = s.find_first_not_of(" \t");
+  const auto e = s.find_last_not_of(" \t");
+  return b == std::string_view::npos ? "" : std::string(s.substr(b, e - b + 1));
+}
+
+// "a.b.c=VALUE": VALUE is TOML if it parses, else a bare string. The override is parsed as a
+// one-line TOML document with source "SCENE (--set)" and merged like one more file on top, so the tables
+// it creates and the value it sets carry that name into any error message.
+void apply_override(toml::table& tree, const std::string& text, const std::string& origin) {
+  const std::string source = set_origin(origin);
+  const auto eq = text.find('=');
+  const std::string key = trim(text.substr(0, eq == std::string::npos ? text.size() : eq));
+  auto bad = [&](const std::string& why) { return SceneError(source, key.empty() ? text : key, "", why); };
+  if (eq == std::string::npos) throw bad("malformed override '" + text + "': expected KEY=VALUE, e.g. sim.stop_speed=0.05");
+
+  std::string toml_key;
+  std::size_t start = 0;
+  for (std::size_t dot; start <= key.size(); start = dot + 1) {
+    dot = std::min(key.find('.', start), key.size());
+    const std::string segment = trim(std::string_view(key).substr(start, dot - start));
+    if (segment.empty()) throw bad("malformed override '" + text + "': KEY must be a dotted key such as sim.stop_speed");
+    toml_key += (toml_key.empty() ? "" : ".") + toml_string(segment);
+  }
+  if (key == "extends" || key.rfind("extends.", 0) == 0)
+    throw bad("cannot be overridden: write a scene file that extends the other one");
+
+  const std::string value = trim(std::string_view(text).substr(eq + 1));
+  std::optional<toml::table> doc;
+  if (value.find_first_of("\r\n") == std::string::npos) {  // a newline could smuggle in more keys
+    try {
+      doc = toml::parse(toml_key + " = " + value, std::string_view(source));
+    } catch (const toml::parse_error&) {
+    }
+  }
+  if (!doc) doc = parse_toml(toml_key + " = " + toml_string(value), source);
+  merge(tree, std::move(*doc));
+}
+
+std::string stem_or(const std::string& path, const std::string& fallback) {
+  const std::string stem = fs::path(path).stem().string();
+  return stem.empty() ? fallback : stem;
+}
+
+SceneDef finish_tree(toml::table tree, const std::string& origin, const std::vector<std::string>& overrides) {
+  for (const std::string& o : overrides) apply_override(tree, o, origin);
+  return build(tree, origin, stem_or(origin, "scene"));
+}
+
+}  // namespace
+
+SceneDef default_scene_def() { return SceneDef{}; }
+
+SceneDef load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  std::vector<ChainLink> chain;
+  if (fs::is_regular_file(path)) chain.push_back({fs::weakly_canonical(path), fs::path(path)});
+  return finish_tree(load_tree(path, chain), path, overrides);
+}
+
+SceneDef parse_scene(const std::string& toml_text, const std::string& origin, const std::vector<std::string>& overrides) {
+  std::vector<ChainLink> chain;
+  toml::table tree = resolve_extends(parse_toml(toml_text, origin), origin, fs::current_path(), chain);
+  return finish_tree(std::move(tree), origin, overrides);
+}
+
+}  // namespace dicesim

@@ -1,0 +1,77 @@
+#include "sim/study/monte_carlo.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <thread>
+#include <vector>
+
+namespace dicesim {
+
+void RunCounts::add(const TossResult& r) {
+  switch (r.status) {
+    case TossStatus::Settled:
+      ++settled;
+      ++faces[static_cast<std::size_t>(r.face_index)];
+      break;
+    case TossStatus::Unresolved: ++unresolved; break;
+    case TossStatus::Invalid: ++invalid; break;
+  }
+  bounces += static_cast<std::uint64_t>(r.bounces);
+}
+
+void RunCounts::merge(const RunCounts& o) {
+  for (std::size_t i = 0; i < faces.size(); ++i) faces[i] += o.faces[i];
+  settled += o.settled;
+  unresolved += o.unresolved;
+  invalid += o.invalid;
+  bounces += o.bounces;
+}
+
+RunCounts run_tosses(const DieModel& m, const RunConfig& cfg) {
+  // Chunks are claimed in order from one counter; a chunk is small enough to balance two
+  // threads on short runs and large enough that the counter is never contended.
+  const std::uint64_t chunk = std::clamp<std::uint64_t>(cfg.tosses / 64, 64, 16384);
+  const std::uint64_t n_chunks = (cfg.tosses + chunk - 1) / chunk;
+  const int threads = static_cast<int>(std::max<std::uint64_t>(1, std::min<std::uint64_t>(cfg.threads, n_chunks)));
+
+  std::atomic<std::uint64_t> next{0}, done{0};
+  std::vector<RunCounts> partial(static_cast<std::size_t>(threads));
+  auto work = [&](RunCounts& out) {
+    for (;;) {
+      if (cfg.cancel && cfg.cancel->load(std::memory_order_relaxed)) return;
+      const std::uint64_t c = next.fetch_add(1, std::memory_order_relaxed);
+      if (c >= n_chunks) return;
+      const std::uint64_t lo = c * chunk, hi = std::min(cfg.tosses, lo + chunk);
+      RunCounts local;
+      for (std::uint64_t i = lo; i < hi; ++i) local.add(toss(m, cfg.seed, cfg.first + i));
+      out.merge(local);
+      done.fetch_add(hi - lo, std::memory_order_relaxed);
+    }
+  };
+
+  {
+    std::vector<std::jthread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(work, std::ref(partial[static_cast<std::size_t>(t)]));
+    if (!cfg.progress) {
+      work(partial[0]);
+    } else {
+      // The calling thread works too, so progress comes from a mostly sleeping reporter thread.
+      std::atomic<bool> finished{false};
+      std::jthread reporter([&] {
+        while (!finished.load()) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+          cfg.progress(done.load(), cfg.tosses);
+        }
+      });
+      work(partial[0]);
+      for (auto& th : pool) th.join();
+      finished = true;
+    }
+  }
+  RunCounts total;
+  for (const RunCounts& p : partial) total.merge(p);
+  if (cfg.progress) cfg.progress(done.load(), cfg.tosses);
+  return total;
+}
+
+}  // namespace dicesim

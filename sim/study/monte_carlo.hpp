@@ -1,0 +1,39 @@
+// Many tosses on a thread pool. Toss i depends only on (model, seed, i), and counts are sums,
+// so the result is identical for any number of threads.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+
+#include "sim/body/die_model.hpp"
+#include "sim/models/toss.hpp"
+
+namespace dicesim {
+
+struct RunCounts {
+  std::array<std::uint64_t, 6> faces{};  // settled tosses by face index (+x, -x, +y, -y, +z, -z)
+  std::uint64_t settled = 0, unresolved = 0, invalid = 0;
+  std::uint64_t bounces = 0;  // impacts over all tosses
+
+  std::uint64_t total() const { return settled + unresolved + invalid; }
+  void add(const TossResult& r);
+  void merge(const RunCounts& o);
+  bool operator==(const RunCounts&) const = default;
+};
+
+struct RunConfig {
+  std::uint64_t seed = 1;
+  std::uint64_t first = 0;   // first toss index
+  std::uint64_t tosses = 0;  // count
+  int threads = 1;
+  // Called from a reporter thread about every 100 ms, and once at the end, with (done, total).
+  std::function<void(std::uint64_t, std::uint64_t)> progress;
+  // Set to true from anywhere to stop early: no new chunk starts; counts cover whole chunks only.
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+RunCounts run_tosses(const DieModel& m, const RunConfig& cfg);
+
+}  // namespace dicesim
