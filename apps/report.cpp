@@ -47,13 +47,18 @@ nlohmann::json report_json(const RunReport& r) {
           {"faces", faces},
           {"chi2_uniform", {{"statistic", chi.statistic}, {"dof", chi.dof}, {"p_value", chi.p_value}}},
           {"bounces_per_toss", r.tosses ? static_cast<double>(r.counts.bounces) / static_cast<double>(r.tosses) : 0.0},
+          {"corrections",
+           {{"energy_clamps", r.counts.corrections.energy_clamps},
+            {"pgs_unconverged", r.counts.corrections.pgs_unconverged},
+            {"overlap_fixes", r.counts.corrections.overlap_fixes},
+            {"fallbacks", r.counts.corrections.fallbacks}}},
           {"elapsed_s", r.elapsed_s},
           {"tosses_per_s", rate(r)}};
 }
 
 std::string report_table(const RunReport& r) {
   std::string out;
-  char line[256];
+  char line[320];
   std::snprintf(line, sizeof line, "%s  (fidelity %s, seed %llu, %llu tosses, %d thread%s)\n\n", r.scene.c_str(),
                 r.fidelity.c_str(), static_cast<unsigned long long>(r.seed), static_cast<unsigned long long>(r.tosses),
                 r.threads, r.threads == 1 ? "" : "s");
@@ -68,6 +73,15 @@ std::string report_table(const RunReport& r) {
                 static_cast<unsigned long long>(r.counts.settled), static_cast<unsigned long long>(r.counts.unresolved),
                 static_cast<unsigned long long>(r.counts.invalid));
   out += line;
+  const RunCorrections& k = r.counts.corrections;
+  if (k.any()) {
+    std::snprintf(line, sizeof line,
+                  "corrections: %llu energy clamps, %llu unconverged contact solves, %llu overlap fixes, %llu fallbacks "
+                  "(each should be 0: the physics was repaired)\n",
+                  static_cast<unsigned long long>(k.energy_clamps), static_cast<unsigned long long>(k.pgs_unconverged),
+                  static_cast<unsigned long long>(k.overlap_fixes), static_cast<unsigned long long>(k.fallbacks));
+    out += line;
+  }
   const ChiSquare chi = chi2_uniform(r.counts.faces);
   std::snprintf(line, sizeof line, "chi-square vs a fair die: %.2f on %d dof, p = %.3g\n", chi.statistic, chi.dof, chi.p_value);
   out += line;

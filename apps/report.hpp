@@ -24,7 +24,8 @@ struct RunReport {
 
 // {"scene", "fidelity", "seed", "threads", "tosses", "settled", "unresolved", "invalid",
 //  "faces": [{"face", "count", "p", "ci95": [lo, hi]}], "chi2_uniform": {"statistic", "p_value"},
-//  "elapsed_s", "tosses_per_s"} -- p and intervals over settled tosses, faces by label.
+//  "corrections": {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks"} (totals over
+//  the run; the table prints a line only when one is non-zero), "elapsed_s", "tosses_per_s"} -- p and intervals over settled tosses, faces by label.
 nlohmann::json report_json(const RunReport& r);
 std::string report_table(const RunReport& r);
 // Prints the run on stdout: one JSON object (json) or the table.

@@ -136,8 +136,10 @@ TEST(FrictionImpact, FaceFirstLandingIsASymmetricFourPointImpact) {
   ASSERT_EQ(c.n, 4);
   apply_friction_impact(m, s, c, true);
   EXPECT_NEAR(s.velocity.z(), 0.5 * 2.0, 1e-9);  // restitution 0.5, all four corners alike
-  EXPECT_NEAR(s.velocity.x(), 0.0, 1e-12);
-  EXPECT_NEAR(s.omega.norm(), 0.0, 1e-9);
+  // Gauss-Seidel converges to 1e-11 of the speeds involved (2 m/s): no sideways motion or spin
+  // beyond that.
+  EXPECT_NEAR(s.velocity.x(), 0.0, 1e-10);
+  EXPECT_NEAR(s.omega.norm() * m.bounding_radius, 0.0, 1e-10);
 }
 
 TEST(Friction, SlidingDieDeceleratesAtMuG) {

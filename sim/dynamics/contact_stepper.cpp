@@ -1,7 +1,9 @@
 #include "sim/dynamics/contact_stepper.hpp"
 
 #include <cmath>
+#include <limits>
 
+#include "sim/dynamics/contact.hpp"
 #include "sim/dynamics/friction_impact.hpp"
 #include "sim/dynamics/rest.hpp"
 
@@ -10,8 +12,8 @@ namespace dicesim {
 FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshold)
     : m_(&m),
       h_(h),
-      v_impact_(4.0 * m.gravity * h),
-      touch_tol_(1e-9 * m.bounding_radius) {
+      v_impact_(sustained_contact_speed(m, h)),
+      touch_tol_(1e-7 * m.bounding_radius) {
   if (threshold == ImpactThreshold::Contact) {
     // Gravity keeps its safety factor 4; contact forces of order m g (normal plus friction) at
     // lever r add at most (1 + mu) g m r^2 / I_min per unit time; the spin adds |w|^2 r (factor 4).
@@ -22,79 +24,223 @@ FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshol
   }
 }
 
+namespace {
+
+double mechanical_energy(const DieModel& m, const RigidState& s) {
+  return kinetic_energy(m, s) + m.mass * m.gravity * s.position.z();
+}
+
+double relative_gain(double before, double after) {
+  return before > 0.0 ? (after - before) / before : (after > 0.0 ? after : 0.0);
+}
+
+}  // namespace
+
+double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& v, const TorqueFreeRotation& rot,
+                                double t) const {
+  // At t = 0 the step's own orientation, bit for bit as touching_corners saw it (so a corner left
+  // out of the contact set is above the tolerance here too).
+  const Mat3 R = t == 0.0 ? rot_start_ : rot.orientation(t);
+  const auto& verts = m_->vertices;
+  const int nv = static_cast<int>(verts.size());
+  double low = std::numeric_limits<double>::infinity();
+  int j = 0;  // c.vertex is ascending
+  for (int i = 0; i < nv; ++i) {
+    if (j < c.n && c.vertex[j] == i) {
+      ++j;
+      continue;
+    }
+    low = std::min(low, R.row(2).dot(verts[i]));
+  }
+  return p.z() + v.z() * t + low;
+}
+
+void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, double* first_touch) {
+  const DieModel& m = *m_;
+  a.s = s0;
+  RigidState& s = a.s;
+  // Impact first, at the instant of contact, on the velocity before gravity's kick: restitution
+  // returns the approach speed the corner really had (after the kick it would return g h more,
+  // and gain energy). Then gravity, then the plastic solve that holds the die up.
+  a.impact = false;
+  a.next.n = 0;
+  if (c.n > 0) {
+    double un = 0.0;
+    for (int i = 0; i < c.n; ++i) un = std::min(un, corner_velocity(m, s, c.vertex[i]).z());
+    a.impact = un < -(v_impact_ + v_spin_ * s.omega.squaredNorm());
+    if (a.impact) a.imp = apply_friction_impact(m, s, c, /*restitution=*/true);
+  }
+  s.velocity.z() -= m.gravity * d;
+  if (c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next);
+
+  // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact).
+  const Vec3 L = world_inertia(m, s.R) * s.omega;
+  const TorqueFreeRotation rot(m.principal_moments, s.R, L);
+  rot_start_ = s.R;
+  const Vec3 p = s.position, v = s.velocity;
+  a.G = lowest_new(c, p, v, rot, d);
+  if (first_touch && a.G < -touch_tol_) {
+    // Where this trajectory first touches (the first guess of the step length): f(lo) > 0 >= f(hi).
+    double lo = 0.0, hi = d, f_lo = lowest_new(c, p, v, rot, 0.0), f_hi = a.G;
+    int side = 0;
+    for (int it = 0; it < 100 && f_lo > touch_tol_ && hi - lo > 1e-15 * d; ++it) {
+      double mid = hi - f_hi * (hi - lo) / (f_hi - f_lo);
+      if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
+      const double f = lowest_new(c, p, v, rot, mid);
+      if (f > 0.0) {
+        lo = mid, f_lo = f;
+        if (side == -1) f_hi *= 0.5;
+        side = -1;
+      } else {
+        hi = mid, f_hi = f;
+        if (side == 1) f_lo *= 0.5;
+        side = 1;
+      }
+    }
+    *first_touch = lo > 0.0 ? lo : hi;
+  }
+  s.position = p + d * v;
+  Vec3 w;
+  rot.state(d, s.R, w);
+  s.omega = w;
+}
+
+// Trials of the shortened step's length (each a whole step) before taking the best one.
+constexpr int kMaxTrials = 12;
+
 int FixedStepper::step(RigidState& s) {
   const DieModel& m = *m_;
-  s.velocity.z() -= m.gravity * h_;
-
-  int n = 0;
-  if (s.position.z() <= m.bounding_radius + touch_tol_) {
-    const ContactSet c = touching_corners(m, s, touch_tol_);
-    n = c.n;
-    if (n > 0) {
-      double un = 0.0;
-      for (int i = 0; i < n; ++i) un = std::min(un, corner_velocity(m, s, c.vertex[i]).z());
-      const bool impact = un < -(v_impact_ + v_spin_ * s.omega.squaredNorm());
-      const ImpactResult r = apply_friction_impact(m, s, c, impact);
-      if (impact) ++impacts;
-      if (r.energy_clamped) ++energy_clamps;
+  ContactSet c;
+  if (s.position.z() <= m.bounding_radius + touch_tol_) c = touching_corners(m, s, touch_tol_);
+  const RigidState s0 = s;
+  const double E0 = mechanical_energy(m, s0);
+  double first = h_;
+  try_step(s0, c, h_, a_, &first);
+  const Attempt* done = &a_;
+  double dt = h_;
+  if (a_.G < -touch_tol_) {
+    // A corner not yet touching would end the step below the floor. The step is shortened to the
+    // instant it touches: the length d whose whole step (gravity's kick g d, the contact solve,
+    // the free motion) ends with that corner on the floor, G(d) = 0 (G: the lowest such corner's
+    // height at the step's end). Illinois on G from the bracket [0, h], first guess the touch
+    // of the full step's own trajectory. Each trial is a whole step, so the accepted one keeps
+    // every property of a step (energy included).
+    const Vec3 z_row = s0.R.row(2).transpose();
+    double g_lo = std::numeric_limits<double>::infinity();
+    {
+      int j = 0;
+      for (int i = 0; i < static_cast<int>(m.vertices.size()); ++i) {
+        if (j < c.n && c.vertex[j] == i) {
+          ++j;
+          continue;
+        }
+        g_lo = std::min(g_lo, s0.position.z() + z_row.dot(m.vertices[i]));
+      }
     }
+    double d_lo = 0.0, d_hi = h_, g_hi = a_.G;
+    double d = first > 0.0 && first < h_ ? first : 0.5 * h_;
+    bool have_lo = false;
+    int side = 0;
+    done = nullptr;
+    for (int k = 0; k < kMaxTrials; ++k) {
+      try_step(s0, c, d, b_, nullptr);
+      if (std::abs(b_.G) <= touch_tol_) {
+        done = &b_;
+        dt = d;
+        break;
+      }
+      if (b_.G > 0.0) {
+        d_lo = d, g_lo = b_.G;
+        std::swap(b_, lo_);
+        have_lo = true;
+        if (side == -1) g_hi *= 0.5;
+        side = -1;
+      } else {
+        d_hi = d, g_hi = b_.G;
+        if (side == 1) g_lo *= 0.5;
+        side = 1;
+      }
+      d = d_hi - g_hi * (d_hi - d_lo) / (g_hi - g_lo);
+      if (!(d > d_lo && d < d_hi)) d = 0.5 * (d_lo + d_hi);
+    }
+    if (!done) {
+      // Not within the tolerance in kMaxTrials trials (the touch is nearly tangential): the longest
+      // trial that ends above the floor; the corner touches in the next step.
+      if (have_lo) {
+        done = &lo_;
+        dt = d_lo;
+      } else {  // every trial ended below: the shortest, its corner within rounding of the floor
+        try_step(s0, c, d_hi, b_, nullptr);
+        done = &b_;
+        dt = d_hi;
+      }
+    }
+    ++located;
   }
-
-  // Positions: COM with the new velocity, rotation by exp(h omega) with L held.
-  const Vec3 L = s.R * m.principal_moments.cwiseProduct(s.R.transpose() * s.omega);
-  s.position += h_ * s.velocity;
-  const Vec3 half = 0.5 * h_ * s.omega;
-  const double a = half.norm();
-  if (a > 0.0) {
-    const double k = std::sin(a) / a;
-    const Quat dq(std::cos(a), k * half.x(), k * half.y(), k * half.z());
-    s.R = (dq * Quat(s.R)).normalized().toRotationMatrix();
-    s.omega = s.R * (s.R.transpose() * L).cwiseQuotient(m.principal_moments);
+  const Attempt& a = *done;
+  s = a.s;
+  if (a.impact) {
+    ++impacts;
+    corrections.add(a.imp.corrections);
+    sweeps += static_cast<std::uint64_t>(a.imp.iterations);
+    max_energy_gain = std::max(max_energy_gain, relative_gain(a.imp.energy_before, a.imp.energy_after));
   }
-
-  // Penetration is projected out (the energy test counts it, so it cannot hide energy).
-  if (s.position.z() <= m.bounding_radius) {
-    double low = 0.0;
-    for (const Vec3& v : m.vertices) low = std::min(low, s.position.z() + s.R.row(2).dot(v));
-    s.position.z() -= low;
+  if (c.n > 0) {
+    corrections.add(a.sup.corrections);
+    sweeps += static_cast<std::uint64_t>(a.sup.iterations);
+    max_energy_gain = std::max(max_energy_gain, relative_gain(a.sup.energy_before, a.sup.energy_after));
   }
-  return n;
+  warm_ = a.next;
+  dt_ = dt;
+  max_energy_gain = std::max(max_energy_gain, relative_gain(E0, mechanical_energy(m, s)));
+  return c.n;
 }
 
 StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int& impacts, double h, double tiebreak,
-                               bool allow_liftoff, ImpactThreshold threshold) {
+                               bool allow_liftoff, ImpactThreshold threshold, StepperStats* stats) {
   StepperOutcome out;
   FixedStepper st(m, h, threshold);
   st.impacts = impacts;
   const double g = m.gravity, r = m.bounding_radius;
   const double ke_rest = 1e-14 * m.mass * g * r;
   const double nudge = 1e-4 * std::sqrt(g / r);
-  const auto max_steps = static_cast<long long>(std::ceil((m.max_time - t) / h));
-  for (long long k = 0; k < max_steps; ++k) {
+  // Steps shortened to a new contact make more steps than (max_time - t) / h: a generous cap on
+  // the count as well, so that nothing can loop forever.
+  const auto max_steps = 4 * static_cast<long long>(std::ceil((m.max_time - t) / h)) + 1000;
+  std::uint64_t steps = 0;
+  const auto finish = [&](StepperExit exit) {
+    out.exit = exit;
+    impacts = st.impacts;
+    if (stats) {
+      stats->corrections.add(st.corrections);
+      stats->sweeps += st.sweeps;
+      stats->steps += steps;
+      stats->located += st.located;
+      stats->max_energy_gain = std::max(stats->max_energy_gain, st.max_energy_gain);
+    }
+    return out;
+  };
+  for (long long k = 0; k < max_steps && t < m.max_time; ++k) {
     const int f = rest_face_down(m, s, tiebreak);
     if (f >= 0) {
-      out.exit = StepperExit::Settled;
       out.face_down = f;
-      impacts = st.impacts;
-      return out;
+      return finish(StepperExit::Settled);
     }
     const int n = st.step(s);
-    t += h;
+    ++steps;
+    t += st.last_dt();
     if (st.impacts >= m.max_bounces) break;
     if (n == 0) {
       if (!allow_liftoff) continue;
       bool clear = true;
-      for (int i = 0; i < 8 && clear; ++i) {
-        const Vec3 ri = s.R * m.vertices[i];
+      for (const Vec3& v : m.vertices) {
+        const Vec3 ri = s.R * v;
         const double z = s.position.z() + ri.z();
         const double vz = (s.velocity + s.omega.cross(ri)).z();
         clear = z + 2.0 * h * std::min(0.0, vz) - 2.0 * g * h * h > 1e-9 * r;
+        if (!clear) break;
       }
-      if (clear) {
-        out.exit = StepperExit::LiftOff;
-        impacts = st.impacts;
-        return out;
-      }
+      if (clear) return finish(StepperExit::LiftOff);
       continue;
     }
     // At rest but undecided: an exact balance on an edge or a corner. Break it the toss's way.
@@ -114,9 +260,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       ++out.nudges;
     }
   }
-  impacts = st.impacts;
-  out.exit = StepperExit::Unresolved;
-  return out;
+  return finish(StepperExit::Unresolved);
 }
 
 }  // namespace dicesim

@@ -1,19 +1,30 @@
-// Fixed-step time integration of the die with the floor: gravity, torque-free rotation (world
-// angular momentum held between impulses), and at every step the corners touching the floor
-// solved together with Coulomb friction (sim/friction_impact.hpp): with restitution when a corner
-// arrives faster than the impact threshold (an impact), perfectly plastic otherwise (sustained
-// contact: resting, sliding, rolling, tipping). Semi-implicit Euler, first order: the answer
-// converges as h -> 0. The whole of the `stepped` fidelity, and `impulse`'s sustained-contact phases.
+// Fixed-step time integration of the die with the floor: gravity, exact torque-free rotation
+// (sim/torque_free.hpp) and straight COM motion between the step's impulses, and at every step
+// the corners touching the floor solved together with Coulomb friction (sim/friction_impact.hpp):
+// first an impact with restitution if a corner arrives faster than the impact threshold, then,
+// with the step's gravity applied, the perfectly plastic contact solve that supports the die
+// (resting, sliding, rolling, tipping). Semi-implicit Euler, first order: the answer converges as
+// h -> 0. A corner that would reach the floor inside a step is not pushed back out of it: the step
+// is shortened to the instant it touches (located by a root search on the step's free motion), so
+// its impact is solved where and when it happens. The whole of the `stepped` fidelity, and
+// `impulse`'s sustained-contact phases.
+//
+// Energy: no step gains mechanical energy E = kinetic + m g z_com (the rotation is exact, a step
+// without contact loses m g^2 h^2 / 2, the plastic solve after gravity's kick loses at least
+// (F - m g h)^2 / 2m with F its normal impulse, and no impact gains). `max_energy_gain` records
+// the largest relative gain seen, for the tests.
 #pragma once
 
 #include "sim/body/die_model.hpp"
+#include "sim/dynamics/corrections.hpp"
 #include "sim/dynamics/flight.hpp"
+#include "sim/dynamics/friction_impact.hpp"
 
 namespace dicesim {
 
 // Which approach speed makes a step's contact an impact (restitution, counted against
 // sim.max_bounces) rather than sustained contact (plastic, not counted).
-//  Gravity: 4 g h, what gravity alone adds in a step (`impulse`'s sustained contact, unchanged).
+//  Gravity: 4 g h, what gravity alone adds in a step (`impulse`'s sustained contact).
 //  Contact: h (4 g + (1 + mu_max) g m r^2 / I_min + 4 |w|^2 r), r the bounding radius: a bound on
 //   a corner's approach built up in one step of sustained contact, from gravity, from the angular
 //   acceleration that contact forces of order m g (normal plus friction) give at lever r, and
@@ -25,21 +36,47 @@ namespace dicesim {
 //   does not), so the limit h -> 0 is the same physics.
 enum class ImpactThreshold { Gravity, Contact };
 
+// The approach speed below which `impulse` hands a contact to the stepper (sustained contact),
+// and below which the stepper (Gravity threshold) treats a contact as plastic: 4 g h. Faster
+// contacts are impacts, solved exactly at their instant.
+inline double sustained_contact_speed(const DieModel& m, double h) { return 4.0 * m.gravity * h; }
+
 class FixedStepper {
  public:
   FixedStepper(const DieModel& m, double h, ImpactThreshold threshold = ImpactThreshold::Gravity);
 
-  // Advances s by one step h. Returns the number of corners that were in contact.
+  // Advances s by one step: h, or less if a new corner reaches the floor first (last_dt()).
+  // Returns the number of corners that were in contact at the step's start.
   int step(RigidState& s);
 
   double h() const { return h_; }
-  int impacts = 0;          // steps whose contact solve had restitution
-  int energy_clamps = 0;    // impacts the energy guard scaled back
+  double last_dt() const { return dt_; }
+  int impacts = 0;                // steps whose contact solve had restitution
+  Corrections corrections;        // of every solve and step so far
+  std::uint64_t sweeps = 0;       // Gauss-Seidel sweeps of every solve so far
+  std::uint64_t located = 0;      // steps shortened to a new contact's instant
+  double max_energy_gain = 0.0;   // largest relative gain of one impact's kinetic or one step's mechanical energy
 
  private:
+  // One trial step of length d from s0 with contact set c; first_touch (optional): where its
+  // free motion first brings a corner not in c to the floor, when it does within d.
+  struct Attempt {
+    RigidState s;
+    bool impact = false;
+    ImpactResult imp, sup;
+    ContactImpulses next;
+    double G = 0.0;  // lowest height at the step's end over corners not in c
+  };
+  void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, double* first_touch);
+  // The lowest height over corners not in c, at time t of the free motion after the step's solve.
+  double lowest_new(const ContactSet& c, const Vec3& p, const Vec3& v, const TorqueFreeRotation& rot, double t) const;
   const DieModel* m_;
   double h_, v_impact_, touch_tol_;
   double v_spin_ = 0.0;  // Contact: 4 h r, the factor of |w|^2 in the threshold
+  double dt_ = 0.0;
+  Mat3 rot_start_ = Mat3::Identity();  // orientation at the start of the step being tried
+  Attempt a_, b_, lo_;                  // trial steps (members: ContactImpulses is large)
+  ContactImpulses warm_;  // the last plastic solve's impulses (warm start of the next)
 };
 
 enum class StepperExit { Settled, LiftOff, Unresolved };
@@ -50,11 +87,22 @@ struct StepperOutcome {
   int nudges = 0;      // exact balances broken by the toss's tiebreak
 };
 
+// Stepper statistics handed back to the toss.
+struct StepperStats {
+  Corrections corrections;
+  std::uint64_t sweeps = 0;
+  std::uint64_t steps = 0;
+  std::uint64_t located = 0;  // steps shortened to a new contact's instant
+  double max_energy_gain = 0.0;
+};
+
 // Steps from (s, t) until the die must come to rest (sim/rest.hpp), the time cap, the impact cap
 // (`impacts` counts on), or, with allow_liftoff, until no corner touches or will touch within two
 // steps (the caller's exact flight takes over). A die at rest in an exact unstable balance (on an
-// edge or corner) gets an infinitesimal spin whose direction comes from `tiebreak`.
+// edge or corner) gets an infinitesimal spin whose direction comes from `tiebreak`. `stats`, if
+// given, accumulates the corrections, sweeps and energy check of the steps.
 StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int& impacts, double h, double tiebreak,
-                               bool allow_liftoff, ImpactThreshold threshold = ImpactThreshold::Gravity);
+                               bool allow_liftoff, ImpactThreshold threshold = ImpactThreshold::Gravity,
+                               StepperStats* stats = nullptr);
 
 }  // namespace dicesim

@@ -15,13 +15,21 @@ Mat3 skew(const Vec3& r) {
   return X;
 }
 
+// Sweep caps of the Gauss-Seidel solves; reaching one is counted (pgs_unconverged).
+constexpr int kMaxSweeps = 200;
+// Converged when a whole sweep changed the body's velocity (v, and w times the bounding radius)
+// by less than this fraction of the speeds involved. (A test on the impulses would never pass on a
+// face, whose split of the load over its corners is not unique; the velocities are.)
+constexpr double kSweepTolerance = 1e-11;
+
 // The contact points of one solve: lever arms, materials and the compliance blocks.
 struct Points {
   int n = 0;
   Vec3 r[kMaxContacts];
   double e[kMaxContacts], mu[kMaxContacts];
   double inv_wnn[kMaxContacts];              // 1 / W_nn
-  Eigen::Matrix2d inv_wtt[kMaxContacts];     // (tangential 2x2 block of W)^-1
+  Eigen::Matrix2d wtt[kMaxContacts];         // tangential 2x2 block of W
+  Eigen::Matrix2d inv_wtt[kMaxContacts];     // its inverse
   Mat3 W0;                                   // full compliance of point 0 (single-contact law)
 };
 
@@ -36,47 +44,58 @@ struct Body {
   Vec3 point_velocity(const Vec3& r) const { return s->velocity + s->omega.cross(r); }
 };
 
+// How much a sweep moved the body: |dv| + radius |dw|.
+struct SweepProbe {
+  Vec3 v, w;
+  explicit SweepProbe(const Body& b) : v(b.s->velocity), w(b.s->omega) {}
+  double change(const Body& b, double radius) const {
+    return (b.s->velocity - v).norm() + radius * (b.s->omega - w).norm();
+  }
+};
+
 Mat3 compliance(const Body& b, const Vec3& r) {
   const Mat3 X = skew(r);
   return b.inv_mass * Mat3::Identity() - X * b.inv_inertia * X;
 }
 
-// Projected Gauss-Seidel on the perfectly plastic frictional contact problem: at every point
-// P_n >= 0, u_n >= 0, P_n u_n = 0, |P_t| <= mu P_n (the sticking impulse, else on the cone).
-// Returns the normal impulses in `pn`.
-void solve_plastic(const Body& b, const Points& pts, double pn[], Eigen::Vector2d pt[]) {
-  constexpr int kMaxIterations = 200;
-  for (int i = 0; i < pts.n; ++i) {
-    pn[i] = 0.0;
-    pt[i].setZero();
+// argmin over |x| <= radius of x.A x / 2 + g.x, A symmetric positive definite 2x2: the exact
+// energy minimiser of one point's tangential impulse (a trust-region subproblem). Inside: -A^-1 g;
+// else x = -(A + lambda 1)^-1 g on the circle, lambda > 0 by Newton on 1/|x(lambda)| - 1/radius
+// (monotone and convergent from lambda = 0, More & Sorensen), in A's eigenbasis.
+Eigen::Vector2d min_on_disc(const Eigen::Matrix2d& A, const Eigen::Vector2d& g, double radius) {
+  if (!(radius > 0.0)) return Eigen::Vector2d::Zero();
+  const double a = A(0, 0), b = A(0, 1), c = A(1, 1);
+  const double det = a * c - b * b;
+  const Eigen::Vector2d x0(-(c * g.x() - b * g.y()) / det, -(a * g.y() - b * g.x()) / det);
+  if (x0.squaredNorm() <= radius * radius) return x0;
+  // Eigen-decomposition of the 2x2 (closed form).
+  const double mean = 0.5 * (a + c), diff = 0.5 * (a - c);
+  const double root = std::hypot(diff, b);
+  const double l1 = mean - root, l2 = mean + root;  // ascending
+  // Eigenvector of l1 from the better-conditioned row of (A - l1 1) q1 = 0.
+  Eigen::Vector2d q1(1.0, 0.0);
+  if (root > 0.0) q1 = (diff >= 0.0 ? Eigen::Vector2d(b, -(diff + root)) : Eigen::Vector2d(root - diff, -b)).normalized();
+  const Eigen::Vector2d q2(-q1.y(), q1.x());
+  const double c1 = q1.dot(g), c2 = q2.dot(g);
+  double lambda = 0.0;
+  for (int it = 0; it < 60; ++it) {
+    const double d1 = l1 + lambda, d2 = l2 + lambda;
+    const double y1 = c1 / d1, y2 = c2 / d2;
+    const double norm2 = y1 * y1 + y2 * y2;
+    const double norm = std::sqrt(norm2);
+    if (std::abs(norm - radius) <= 1e-14 * radius) break;
+    // phi = 1/|x| - 1/radius, phi' = (sum c_i^2 / d_i^3) / |x|^3: Newton from the left of the root
+    // increases lambda monotonically (phi is concave there).
+    const double phi = 1.0 / norm - 1.0 / radius;
+    const double dphi = (y1 * y1 / d1 + y2 * y2 / d2) / (norm2 * norm);
+    const double next = std::max(0.0, lambda - phi / dphi);
+    if (next == lambda) break;
+    lambda = next;
   }
-  for (int it = 0; it < kMaxIterations; ++it) {
-    double change = 0.0, total = 0.0;
-    for (int i = 0; i < pts.n; ++i) {
-      const Vec3& r = pts.r[i];
-      Vec3 u = b.point_velocity(r);
-      const double new_n = std::max(0.0, pn[i] - u.z() * pts.inv_wnn[i]);
-      const double dn = new_n - pn[i];
-      pn[i] = new_n;
-      if (dn != 0.0) b.apply(r, Vec3(0.0, 0.0, dn));
-      u = b.point_velocity(r);
-      const Eigen::Vector2d slip(u.x(), u.y());
-      Eigen::Vector2d t = pt[i] - pts.inv_wtt[i] * slip;
-      const double limit = pts.mu[i] * pn[i];
-      const double tn = t.norm();
-      if (tn > limit) {
-        // Sliding: Coulomb friction at the cone's edge, opposite to the slip (maximal dissipation).
-        const double sn = slip.norm();
-        t = sn > 0.0 ? Eigen::Vector2d(-limit * slip / sn) : Eigen::Vector2d(t * (limit / tn));
-      }
-      const Eigen::Vector2d dt = t - pt[i];
-      pt[i] = t;
-      if (dt.x() != 0.0 || dt.y() != 0.0) b.apply(r, Vec3(dt.x(), dt.y(), 0.0));
-      change = std::max(change, std::abs(dn) + dt.norm());
-      total += pn[i];
-    }
-    if (change <= 1e-14 * total || total == 0.0) break;
-  }
+  Eigen::Vector2d x = -(c1 / (l1 + lambda)) * q1 - (c2 / (l2 + lambda)) * q2;
+  const double xn = x.norm();
+  if (xn > radius) x *= radius / xn;  // rounding: stay in the cone
+  return x;
 }
 
 // Plastic sliding impulse at one point, P = lambda (mu d + n) with d a unit vector: lambda
@@ -233,21 +252,104 @@ bool solve_plastic_single(const Body& b, const Points& pts, double pn[], Eigen::
 
 }  // namespace
 
+namespace {
+
+struct SweepResult {
+  int sweeps = 0;
+  bool converged = true;
+};
+
+// Projected Gauss-Seidel on the perfectly plastic frictional contact problem: at every point
+// P_n >= 0, u_n >= 0, P_n u_n = 0, |P_t| <= mu P_n, friction opposite the final slip. Each normal
+// update is the exact minimiser of the kinetic energy over P_n >= 0; the tangential one sticks or
+// puts the friction on the cone's edge opposite the current slip: its fixed points are exactly
+// Coulomb's law with maximal dissipation. Sweeps alternate forward and backward
+// (symmetric Gauss-Seidel: no point is always solved last). Starts from the impulses in pn, pt
+// (already applied to the body: a warm start, or zero).
+SweepResult solve_plastic(const Body& b, const Points& pts, double pn[], Eigen::Vector2d pt[], double radius,
+                          double speed) {
+  for (int it = 0; it < kMaxSweeps; ++it) {
+    const SweepProbe probe(b);
+    for (int k = 0; k < pts.n; ++k) {
+      const int i = it % 2 == 0 ? k : pts.n - 1 - k;
+      const Vec3& r = pts.r[i];
+      Vec3 u = b.point_velocity(r);
+      const double new_n = std::max(0.0, pn[i] - u.z() * pts.inv_wnn[i]);
+      const double dn = new_n - pn[i];
+      if (dn != 0.0) {
+        pn[i] = new_n;
+        b.apply(r, Vec3(0.0, 0.0, dn));
+        u = b.point_velocity(r);
+      }
+      // Tangential: the sticking update, or on the cone's edge opposite the slip (whose fixed
+      // points are the same Coulomb law as the exact disc minimiser's, at a fraction of the cost).
+      const Eigen::Vector2d slip(u.x(), u.y());
+      Eigen::Vector2d t = pt[i] - pts.inv_wtt[i] * slip;
+      const double limit = pts.mu[i] * pn[i];
+      const double tn = t.norm();
+      if (tn > limit) {
+        const double sn = slip.norm();
+        t = sn > 0.0 ? Eigen::Vector2d(-limit * slip / sn) : Eigen::Vector2d(t * (limit / tn));
+      }
+      const Eigen::Vector2d dt = t - pt[i];
+      pt[i] = t;
+      if (dt.x() != 0.0 || dt.y() != 0.0) b.apply(r, Vec3(dt.x(), dt.y(), 0.0));
+    }
+    if (probe.change(b, radius) <= kSweepTolerance * speed) return {it + 1, true};
+  }
+  return {kMaxSweeps, false};
+}
+
+// Friction of the restitution phase: tangential impulses only, |P_t,i| <= radius_i, minimising the
+// kinetic energy (a convex problem: every block update lowers it, so this phase only dissipates;
+// its solution has the friction opposite the final slip at every sliding point). From zero.
+SweepResult solve_friction(const Body& b, const Points& pts, const double radius[], Eigen::Vector2d pt[],
+                           double lever, double speed) {
+  double total = 0.0;
+  for (int i = 0; i < pts.n; ++i) {
+    pt[i].setZero();
+    total += radius[i];
+  }
+  if (total == 0.0) return {0, true};
+  const int max_sweeps = pts.n == 1 ? 1 : kMaxSweeps;  // one point: one exact update
+  for (int it = 0; it < max_sweeps; ++it) {
+    const SweepProbe probe(b);
+    for (int k = 0; k < pts.n; ++k) {
+      const int i = it % 2 == 0 ? k : pts.n - 1 - k;
+      if (radius[i] == 0.0) continue;
+      const Vec3 u = b.point_velocity(pts.r[i]);
+      const Eigen::Vector2d g = Eigen::Vector2d(u.x(), u.y()) - pts.wtt[i] * pt[i];
+      const Eigen::Vector2d t = min_on_disc(pts.wtt[i], g, radius[i]);
+      const Eigen::Vector2d dt = t - pt[i];
+      pt[i] = t;
+      if (dt.x() != 0.0 || dt.y() != 0.0) b.apply(pts.r[i], Vec3(dt.x(), dt.y(), 0.0));
+    }
+    if (pts.n == 1 || probe.change(b, lever) <= kSweepTolerance * speed) return {pts.n == 1 ? 0 : it + 1, true};
+  }
+  return {kMaxSweeps, false};
+}
+
+}  // namespace
+
 ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol) {
   ContactSet c;
-  for (int i = 0; i < 8; ++i)
+  const int nv = static_cast<int>(m.vertices.size());
+  for (int i = 0; i < nv && c.n < kMaxContacts; ++i)
     if (s.position.z() + s.R.row(2).dot(m.vertices[i]) <= tol) c.vertex[c.n++] = i;
   return c;
 }
 
-ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution) {
-  ImpactResult out;
-  if (c.n == 0) return out;
+ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,
+                                   const ContactImpulses* warm, ContactImpulses* out) {
+  ImpactResult res;
+  if (out) out->n = 0;
+  if (c.n == 0) return res;
   const RigidState s0 = s;
   const Mat3 Iw = world_inertia(m, s.R);
   Body b{m.mass, 1.0 / m.mass, s.R * m.principal_moments.cwiseInverse().asDiagonal() * s.R.transpose(), &s};
   Points pts;
   pts.n = c.n;
+  double u0n[kMaxContacts];
   for (int i = 0; i < c.n; ++i) {
     const int v = c.vertex[i];
     pts.r[i] = s.R * m.vertices[v];
@@ -256,75 +358,152 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
     const Mat3 W = compliance(b, pts.r[i]);
     if (i == 0) pts.W0 = W;
     pts.inv_wnn[i] = 1.0 / W(2, 2);
-    pts.inv_wtt[i] = W.topLeftCorner<2, 2>().inverse();
+    pts.wtt[i] = W.topLeftCorner<2, 2>();
+    pts.inv_wtt[i] = pts.wtt[i].inverse();
+    u0n[i] = b.point_velocity(pts.r[i]).z();
   }
-  const auto energy = [&](const RigidState& x) { return 0.5 * m.mass * x.velocity.squaredNorm() + 0.5 * x.omega.dot(Iw * x.omega); };
-  out.energy_before = energy(s0);
+  const auto energy = [&](const RigidState& x) {
+    return 0.5 * m.mass * x.velocity.squaredNorm() + 0.5 * x.omega.dot(Iw * x.omega);
+  };
+  const double E0 = energy(s0);
+  res.energy_before = E0;
+  // The speeds involved (convergence and rounding tests are relative to it).
+  const double lever = m.bounding_radius;
+  const double speed = s0.velocity.norm() + s0.omega.norm() * lever;
 
+  // 1. Compression: the plastic frictional impulse.
   double pn[kMaxContacts];
   Eigen::Vector2d pt[kMaxContacts];
-  if (c.n == 1 && solve_plastic_single(b, pts, pn, pt)) {
-    // One point. Sticking fits the cone: Chatterjee-Ruina, P = P_I + e (P_I.n) n. Sliding: the
-    // plastic sliding impulse of maximal dissipation times (1 + e), rather than CR's projection
-    // of P^ onto the cone (which keeps the sticking normal impulse and can make even a plastic
-    // impact rebound fast).
-    if (restitution && pn[0] > 0.0 && pts.e[0] > 0.0) {
-      const bool sliding = pt[0].norm() >= pts.mu[0] * pn[0] * (1.0 - 1e-12) && pts.mu[0] > 0.0;
-      const Vec3 extra = sliding ? Vec3(pt[0].x(), pt[0].y(), pn[0]) : Vec3(0.0, 0.0, pn[0]);
-      b.apply(pts.r[0], pts.e[0] * extra);
+  bool solved = false;
+  if (c.n == 1) {
+    solved = solve_plastic_single(b, pts, pn, pt);
+    if (!solved) ++res.corrections.fallbacks;  // a jam: no sliding direction stops the point
+  }
+  if (!solved) {
+    for (int i = 0; i < c.n; ++i) {
+      pn[i] = 0.0;
+      pt[i].setZero();
     }
-  } else {
-    solve_plastic(b, pts, pn, pt);  // (one point reaches here only if its exact solve failed)
-    if (restitution) {
-      bool same_e = true;
-      for (int i = 1; i < c.n; ++i) same_e = same_e && pts.e[i] == pts.e[0];
-      if (same_e) {
-        // Poisson with one e: the restitution impulse is e times the compression impulse, whose
-        // effect on the body is unique even where the split over the points is not (a face).
-        s.velocity.z() += pts.e[0] * (s.velocity.z() - s0.velocity.z());
-        double pz = 0.0;
-        Vec3 moment = Vec3::Zero();
+    if (warm && warm->n > 0) {
+      for (int i = 0; i < c.n; ++i)
+        for (int j = 0; j < warm->n; ++j)
+          if (warm->vertex[j] == c.vertex[i]) {
+            pn[i] = std::max(0.0, warm->P[j].z());
+            Eigen::Vector2d t(warm->P[j].x(), warm->P[j].y());
+            const double lim = pts.mu[i] * pn[i], tn = t.norm();
+            if (tn > lim) t *= tn > 0.0 ? lim / tn : 0.0;
+            pt[i] = t;
+            b.apply(pts.r[i], Vec3(t.x(), t.y(), pn[i]));
+            break;
+          }
+      if (energy(s) > E0) {  // a stale warm start that adds energy: start from zero instead
+        s.velocity = s0.velocity;
+        s.omega = s0.omega;
         for (int i = 0; i < c.n; ++i) {
-          pz += pn[i];
-          moment += pts.r[i].cross(Vec3(0.0, 0.0, pn[i]));
+          pn[i] = 0.0;
+          pt[i].setZero();
         }
-        (void)pz;
-        s.omega += pts.e[0] * (b.inv_inertia * moment);
-      } else {
-        for (int i = 0; i < c.n; ++i)
-          if (pn[i] > 0.0 && pts.e[i] > 0.0) b.apply(pts.r[i], Vec3(0.0, 0.0, pts.e[i] * pn[i]));
+      }
+    }
+    const SweepResult sr = solve_plastic(b, pts, pn, pt, lever, speed);
+    res.iterations += sr.sweeps;
+    if (!sr.converged) ++res.corrections.pgs_unconverged;
+  }
+  Vec3 total[kMaxContacts];
+  for (int i = 0; i < c.n; ++i) total[i] = Vec3(pt[i].x(), pt[i].y(), pn[i]);
+
+  // 2. Restitution: energetic, with friction.
+  if (restitution) {
+    double w_sum = 0.0, we_sum = 0.0;
+    for (int i = 0; i < c.n; ++i) {
+      const double w = std::max(0.0, -u0n[i]);
+      w_sum += w;
+      we_sum += w * pts.e[i];
+    }
+    const double e = w_sum > 0.0 ? we_sum / w_sum : 0.0;
+    if (e > 0.0) {
+      double work_n = 0.0;
+      double F = 0.0;
+      Vec3 M = Vec3::Zero();
+      for (int i = 0; i < c.n; ++i) {
+        work_n += pn[i] * 0.5 * (u0n[i] + b.point_velocity(pts.r[i]).z());
+        F += pn[i];
+        M += pts.r[i].cross(Vec3(0.0, 0.0, pn[i]));
+      }
+      const double dE_c = energy(s) - E0;
+      const double stored = std::max(0.0, std::min(-work_n, -dE_c));
+      const double released = e * e * stored;
+      const Vec3 dw = b.inv_inertia * M;
+      // E(k) = E1 + k a + k^2 q / 2 for the normal impulses k pn_i.
+      const double a = s.velocity.z() * F + s.omega.dot(M);
+      const double q = F * F * b.inv_mass + M.dot(dw);
+      if (released > 0.0 && q > 0.0) {
+        const double root = std::sqrt(a * a + 2.0 * q * released);
+        const double k = a >= 0.0 ? 2.0 * released / (a + root) : (root - a) / q;
+        s.velocity.z() += k * F * b.inv_mass;
+        s.omega += k * dw;
+        double radius[kMaxContacts];
+        for (int i = 0; i < c.n; ++i) radius[i] = pts.mu[i] * k * pn[i];
+        Eigen::Vector2d ft[kMaxContacts];
+        const SweepResult sr = solve_friction(b, pts, radius, ft, lever, speed);
+        res.iterations += sr.sweeps;
+        if (!sr.converged) ++res.corrections.pgs_unconverged;
+        for (int i = 0; i < c.n; ++i) total[i] += Vec3(ft[i].x(), ft[i].y(), k * pn[i]);
       }
     }
   }
 
-  // Energy guard: E(lambda) - E0 = lambda a + lambda^2 b for the impulse scaled by lambda.
+  // A point still approaching (rounding aside: < 1e-10 of the speeds involved): the restitution
+  // tipped a neighbour into the floor, or a solve stopped short. One more plastic pass (a new
+  // impact of those points, without restitution); failing that, a frictionless one (always
+  // dissipative: it removes (u.n)^2 / 2 W_nn at each point), counted.
+  const double speed_tol = 1e-10 * speed;
+  const auto approaching = [&] {
+    for (int i = 0; i < c.n; ++i)
+      if (b.point_velocity(pts.r[i]).z() < -speed_tol) return true;
+    return false;
+  };
+  for (int pass = 0; pass < 2 && approaching(); ++pass) {
+    Points p2 = pts;
+    if (pass == 1) {
+      ++res.corrections.fallbacks;
+      for (int i = 0; i < c.n; ++i) p2.mu[i] = 0.0;
+    }
+    for (int i = 0; i < c.n; ++i) {
+      pn[i] = 0.0;
+      pt[i].setZero();
+    }
+    const SweepResult sr = solve_plastic(b, p2, pn, pt, lever, speed);
+    res.iterations += sr.sweeps;
+    if (!sr.converged) ++res.corrections.pgs_unconverged;
+    for (int i = 0; i < c.n; ++i) total[i] += Vec3(pt[i].x(), pt[i].y(), pn[i]);
+  }
+
+  // The energy assertion: by the argument above an impact cannot gain energy, so this scales back
+  // only what rounding (or an unconverged solve) broke, and counts it.
+  // E(lambda) - E0 = lambda a + lambda^2 q for the impulse scaled by lambda.
   double after = energy(s);
-  if (after > out.energy_before * (1.0 + 1e-13)) {  // above rounding (1e-13 relative)
+  if (after > E0 * (1.0 + 1e-12)) {
     const Vec3 dv = s.velocity - s0.velocity, dw = s.omega - s0.omega;
     const double a = m.mass * s0.velocity.dot(dv) + s0.omega.dot(Iw * dw);
     const double q = 0.5 * m.mass * dv.squaredNorm() + 0.5 * dw.dot(Iw * dw);
-    // (1 - 1e-12): the root itself, rounded, could sit a few ulps above E0.
     const double lambda = (a < 0.0 && q > 0.0) ? std::min(1.0, -a / q) * (1.0 - 1e-12) : 0.0;
     s.velocity = s0.velocity + lambda * dv;
     s.omega = s0.omega + lambda * dw;
-    out.energy_clamped = true;
+    for (int i = 0; i < c.n; ++i) total[i] *= lambda;
+    ++res.corrections.energy_clamps;
+    after = energy(s);
   }
-  // A point still approaching (the energy guard scaled the impulse back, or the frictional solve
-  // did not converge): stop it without friction, which is always dissipative (it removes
-  // (u.n)^2 / 2 W_nn at each point).
-  // (Rounding leaves |u_n| ~ 1e-16 of the speeds involved: that is not approaching.)
-  const double speed_tol = 1e-12 * (s0.velocity.norm() + s0.omega.norm() * m.bounding_radius);
-  bool approaching = false;
-  for (int i = 0; i < c.n; ++i) approaching = approaching || b.point_velocity(pts.r[i]).z() < -speed_tol;
-  if (approaching) {
-    Points frictionless = pts;
-    for (int i = 0; i < c.n; ++i) frictionless.mu[i] = 0.0;
-    solve_plastic(b, frictionless, pn, pt);
+  res.energy_after = after;
+  res.normal_impulse = m.mass * (s.velocity.z() - s0.velocity.z());
+  if (out) {
+    out->n = c.n;
+    for (int i = 0; i < c.n; ++i) {
+      out->vertex[i] = c.vertex[i];
+      out->P[i] = total[i];
+    }
   }
-  after = energy(s);
-  out.energy_after = after;
-  out.normal_impulse = m.mass * (s.velocity.z() - s0.velocity.z());
-  return out;
+  return res;
 }
 
 }  // namespace dicesim

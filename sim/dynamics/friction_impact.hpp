@@ -1,29 +1,42 @@
 // Impacts and sustained contacts with Coulomb friction against the floor (z = 0, normal +z):
-// the impact law shared by the `impulse` and `stepped` fidelities.
+// the impact law shared by the `impulse` and `stepped` fidelities, for any number of touching
+// corners (one corner, an edge, a face of any polygon), in two phases with friction in both:
 //
-//  - One contact point: the perfectly plastic frictional impulse first (exact: the sticking impulse
-//    P_I = -W^-1 u if |P_I,t| <= mu P_I,n, W the contact compliance and u the contact-point velocity
-//    v + w x r; else sliding with maximal dissipation, zero final normal velocity, the slip
-//    direction found as a bracketed root in its angle; only a jam falls back to PGS). Then
-//    restitution e of that corner: sticking -> Chatterjee & Ruina (1998) with tangential
-//    restitution 0, P = P_I + e (P_I.n) n; sliding -> Poisson, P = (1 + e) P_slide. (CR's own
-//    projection of (1+e) P_I,n n + P_I,t onto the cone keeps the sticking normal impulse and makes
-//    plastic sliding impacts rebound fast; the sliding branch avoids that.) mu = 0: the
-//    frictionless Newton impulse of `paper`.
-//  - Several simultaneous contacts (an edge: 2, a face: 4) are solved together: the plastic
-//    frictional impact (Coulomb cone at every point, non-negative separation, complementarity)
-//    by projected Gauss-Seidel over the points, then Poisson restitution: normal impulses e_i P_n,i.
-//  - Every impact is checked against the kinetic energy before it: should the result gain energy
-//    (which a frictional multi-contact Poisson law can do in rare configurations), the impulse is
-//    scaled back to the largest fraction that does not. So no impact ever creates energy.
+//  1. Compression: the perfectly plastic frictional impact. At every point P_n >= 0, u_n >= 0,
+//     P_n u_n = 0, |P_t| <= mu P_n, sticking if the impulse fits the cone, else sliding with the
+//     friction opposite the final slip (maximal dissipation). One point: exact (sticking
+//     P = -W^-1 u, else a bracketed root in the slip direction; W the contact compliance
+//     (1/m) 1 - [r]x I_w^-1 [r]x, u the point's velocity v + w x r). Several: projected
+//     Gauss-Seidel where every update is the exact minimiser of the kinetic energy over its own
+//     block (normal: P_n >= 0; tangential: the disc |P_t| <= mu P_n, in the metric of W_tt), so
+//     every sweep lowers the energy; warm-started, symmetric sweeps, converged to 1e-13.
+//  2. Restitution, energetic (Stronge): the normal impulses of compression, scaled by one k,
+//     release e^2 times the energy compression stored in the normal direction, where that is
+//     E_c = min(-W_n, -dE_c): W_n the work of the normal impulses along the compression (straight
+//     impulse path, so exact), dE_c the kinetic energy change of compression (W_n alone can
+//     exceed what compression removed when W couples normal and slip: returning e^2 W_n would
+//     then gain energy, the flaw of Chatterjee-Ruina's P_I + e P_In n at high e). Then friction
+//     again, in the discs |P_t| <= mu k P_n, minimising the kinetic energy (Coulomb with
+//     maximal dissipation against the restitution's slip). Mixed materials: one e for the impact,
+//     sum w_i e_i / sum w_i with w_i the approach speed of point i before the impact, a function of
+//     the state alone (not of the Gauss-Seidel split of a face's load, which is not unique).
+//  So dE = dE_c + e^2 E_c + (friction <= 0) <= (1 - e^2) dE_c <= 0 for any e in [0, 1], any number
+//  of points, converged or not. mu = 0, one point: the Newton impulse of `paper` exactly.
+//  Should the restitution leave a point approaching (a restitution impulse tipping a neighbour
+//  into the floor), one more plastic pass stops it; if even that fails, a frictionless plastic
+//  solve (always dissipative), counted as a fallback. The energy guard is kept as an assertion:
+//  it scales an impulse back only if rounding broke the proof, and counts it (energy_clamps).
 #pragma once
 
 #include "sim/body/die_model.hpp"
+#include "sim/dynamics/corrections.hpp"
 #include "sim/dynamics/flight.hpp"
 
 namespace dicesim {
 
-inline constexpr int kMaxContacts = 8;
+// Simultaneous contact points one solve handles (a face of up to 32 corners; more are ignored
+// beyond the lowest 32, which no ready scene reaches).
+inline constexpr int kMaxContacts = 32;
 
 // The corners of the die that touch the floor at one instant.
 struct ContactSet {
@@ -31,19 +44,30 @@ struct ContactSet {
   int vertex[kMaxContacts] = {};
 };
 
+// Impulses per point of one solve (world: x, y tangential, z normal), in the ContactSet's order.
+struct ContactImpulses {
+  int n = 0;
+  int vertex[kMaxContacts] = {};
+  Vec3 P[kMaxContacts];
+};
+
 struct ImpactResult {
   double normal_impulse = 0.0;  // sum over the points (N s)
   double energy_before = 0.0;   // kinetic energy (J)
   double energy_after = 0.0;
-  bool energy_clamped = false;  // the energy guard scaled the impulse back
+  int iterations = 0;           // Gauss-Seidel sweeps (both phases; 0 for an exact one-point solve)
+  Corrections corrections;      // energy clamp, unconverged solve, fallback of this impact
 };
 
 // Corners of `s` whose height is at most `tol` (m).
 ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol);
 
 // Impact with restitution (true) or perfectly plastic (false, used for sustained contact), with
-// Coulomb friction. Updates s.velocity and s.omega; positions are untouched.
-ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution);
+// Coulomb friction. Updates s.velocity and s.omega; positions are untouched. `warm`: impulses of
+// a previous solve (matched by vertex) to start the compression from; `out`: the impulse at every
+// point (compression plus restitution). Both optional.
+ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,
+                                   const ContactImpulses* warm = nullptr, ContactImpulses* out = nullptr);
 
 // Velocity of corner `vertex`'s contact point (world).
 inline Vec3 corner_velocity(const DieModel& m, const RigidState& s, int vertex) {

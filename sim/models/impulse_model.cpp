@@ -1,6 +1,10 @@
 // `impulse`: event-driven. Exact flight to the next contact, the friction impact law on every
-// corner that touches, and fixed steps only while the die is in sustained contact (a rebound
-// shorter than one contact step); the toss ends when the die must come to rest (sim/rest.hpp).
+// corner that touches, at the exact instant; fixed steps only for sustained contact: a rebound
+// that lands again within one contact step *and* arrives slower than the stepper's impact
+// threshold (4 g contact_step, what gravity adds in a step: a contact that slow gets no
+// restitution in the stepper either). A faster re-strike, however soon, stays an exact event.
+// The toss ends when the die must come to rest (sim/rest.hpp).
+#include <algorithm>
 #include <cmath>
 
 #include "sim/dynamics/contact_stepper.hpp"
@@ -14,18 +18,31 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
   TossResult r;
   double t = 0.0;
   const double set_tol = 1e-6 * m.bounding_radius;  // corners this close strike together
+  const double v_sustained = sustained_contact_speed(m, m.contact_step);
   bool sustained = false;
   bool after_impact = false;  // the state is right after an impact (sustained contact is possible)
+  StepperStats stats;
+  const auto finish = [&](TossStatus status) {
+    r.status = status;
+    r.t_end = t;
+    r.corrections.add(stats.corrections);
+    if (probe) {
+      probe->pgs_sweeps += stats.sweeps;
+      probe->steps += stats.steps;
+      probe->located_steps += stats.located;
+      probe->max_energy_gain = std::max(probe->max_energy_gain, stats.max_energy_gain);
+    }
+    return r;
+  };
   const auto settle = [&](int down) {
-    r.status = TossStatus::Settled;
     r.face_index = opposite_face(down);
     r.face = m.face_labels[r.face_index];
-    r.t_end = t;
-    return r;
+    return finish(TossStatus::Settled);
   };
   for (;;) {
     if (sustained) {
-      const StepperOutcome o = run_fixed_steps(m, s, t, r.bounces, m.contact_step, tiebreak, /*allow_liftoff=*/true);
+      const StepperOutcome o =
+          run_fixed_steps(m, s, t, r.bounces, m.contact_step, tiebreak, /*allow_liftoff=*/true, ImpactThreshold::Gravity, &stats);
       if (o.exit == StepperExit::Settled) return settle(o.face_down);
       if (o.exit == StepperExit::Unresolved) break;
       sustained = false;  // lift-off: back to exact flight
@@ -40,33 +57,44 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
       probe->search_iterations += static_cast<std::uint64_t>(c.iterations);
       ++probe->flights;
     }
-    // A rebound that lands again within one contact step is sustained contact. (The one search
-    // from the state after the impact both decides that and, if not, is the next flight's.)
-    if (after_impact && c.outcome == ContactSearch::Outcome::Contact && c.t <= m.contact_step) {
-      sustained = true;
-      after_impact = false;
-      continue;
-    }
-    after_impact = false;
     if (c.outcome != ContactSearch::Outcome::Contact) {
       t += c.t;
       break;
     }
+    RigidState at = flight.state(c.t);
+    at.R = Quat(at.R).normalized().toRotationMatrix();
+    const ContactSet set = touching_corners(m, at, set_tol);
+    // A slow re-landing within one contact step is sustained contact: the stepper takes over from
+    // the state after the impact. (The one search from that state decides it and, if not, is the
+    // next flight's.)
+    if (after_impact && c.t <= m.contact_step) {
+      double approach = 0.0;
+      for (int i = 0; i < set.n; ++i) approach = std::min(approach, corner_velocity(m, at, set.vertex[i]).z());
+      if (-approach <= v_sustained) {
+        sustained = true;
+        after_impact = false;
+        continue;
+      }
+    }
+    after_impact = false;
     t += c.t;
-    s = flight.state(c.t);
-    s.R = Quat(s.R).normalized().toRotationMatrix();
-    const ContactSet set = touching_corners(m, s, set_tol);
+    s = at;
     const RigidState before = s;
     const ImpactResult imp = apply_friction_impact(m, s, set, /*restitution=*/true);
+    r.corrections.add(imp.corrections);
     ++r.bounces;
-    if (probe && probe->trace)
-      probe->trace->push_back({r.bounces, t, before, s, set.n > 0 ? set.vertex[0] : -1, imp.normal_impulse});
+    if (probe) {
+      probe->pgs_sweeps += static_cast<std::uint64_t>(imp.iterations);
+      if (imp.energy_before > 0.0)
+        probe->max_energy_gain =
+            std::max(probe->max_energy_gain, (imp.energy_after - imp.energy_before) / imp.energy_before);
+      if (probe->trace)
+        probe->trace->push_back({r.bounces, t, before, s, set.n > 0 ? set.vertex[0] : -1, imp.normal_impulse});
+    }
     if (r.bounces >= m.max_bounces) break;
     after_impact = true;
   }
-  r.status = TossStatus::Unresolved;
-  r.t_end = t;
-  return r;
+  return finish(TossStatus::Unresolved);
 }
 
 }  // namespace dicesim

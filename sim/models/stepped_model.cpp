@@ -9,9 +9,17 @@ TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossPro
   TossResult r;
   double t = 0.0;
   int impacts = 0;
+  StepperStats stats;
   const StepperOutcome o = run_fixed_steps(m, s, t, impacts, m.step, tiebreak, /*allow_liftoff=*/false,
-                                           ImpactThreshold::Contact);
-  if (probe) probe->flights += 1;
+                                           ImpactThreshold::Contact, &stats);
+  if (probe) {
+    probe->flights += 1;
+    probe->pgs_sweeps += stats.sweeps;
+    probe->steps += stats.steps;
+    probe->located_steps += stats.located;
+    probe->max_energy_gain = std::max(probe->max_energy_gain, stats.max_energy_gain);
+  }
+  r.corrections = stats.corrections;
   r.bounces = impacts;
   r.t_end = t;
   if (o.exit != StepperExit::Settled) {

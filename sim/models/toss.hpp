@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "sim/body/die_model.hpp"
+#include "sim/dynamics/corrections.hpp"
 #include "sim/dynamics/flight.hpp"
 #include "sim/models/initial_state.hpp"
 
@@ -23,6 +24,7 @@ struct TossResult {
   TossStatus status = TossStatus::Invalid;
   int bounces = 0;
   double t_end = 0.0;  // simulated time at the end (s)
+  Corrections corrections;  // guards and fallbacks that fired during the toss (should all be 0)
 };
 
 // One impact, for traces and replays.
@@ -43,6 +45,13 @@ struct TossProbe {
   double impact_s = 0.0;                       // impulses and the stop rule
   std::uint64_t search_iterations = 0;         // conservative-advancement steps
   std::uint64_t flights = 0;
+  // `impulse` and `stepped`: Gauss-Seidel sweeps of every contact solve, fixed steps taken, and
+  // the largest relative energy gain of any impact (kinetic) or fixed step (kinetic + m g z):
+  // the impact law and the stepper promise it is 0 up to rounding.
+  std::uint64_t pgs_sweeps = 0;
+  std::uint64_t steps = 0;
+  std::uint64_t located_steps = 0;  // fixed steps shortened to the instant a new corner touches
+  double max_energy_gain = 0.0;
 };
 
 // Chatter guard (`paper`): this many impacts in a row, each less than kZenoInterval after the

@@ -17,6 +17,7 @@ void RunCounts::add(const TossResult& r) {
     case TossStatus::Invalid: ++invalid; break;
   }
   bounces += static_cast<std::uint64_t>(r.bounces);
+  corrections.add(r.corrections);
 }
 
 void RunCounts::merge(const RunCounts& o) {
@@ -25,6 +26,7 @@ void RunCounts::merge(const RunCounts& o) {
   unresolved += o.unresolved;
   invalid += o.invalid;
   bounces += o.bounces;
+  corrections.merge(o.corrections);
 }
 
 RunCounts run_tosses(const DieModel& m, const RunConfig& cfg) {

@@ -12,10 +12,30 @@
 
 namespace dicesim {
 
+// Totals over a run of the per-toss corrections (sim/dynamics/corrections.hpp): all should be 0.
+struct RunCorrections {
+  std::uint64_t energy_clamps = 0, pgs_unconverged = 0, overlap_fixes = 0, fallbacks = 0;
+  bool any() const { return energy_clamps || pgs_unconverged || overlap_fixes || fallbacks; }
+  void add(const Corrections& c) {
+    energy_clamps += c.energy_clamps;
+    pgs_unconverged += c.pgs_unconverged;
+    overlap_fixes += c.overlap_fixes;
+    fallbacks += c.fallbacks;
+  }
+  void merge(const RunCorrections& o) {
+    energy_clamps += o.energy_clamps;
+    pgs_unconverged += o.pgs_unconverged;
+    overlap_fixes += o.overlap_fixes;
+    fallbacks += o.fallbacks;
+  }
+  bool operator==(const RunCorrections&) const = default;
+};
+
 struct RunCounts {
   std::array<std::uint64_t, 6> faces{};  // settled tosses by face index (+x, -x, +y, -y, +z, -z)
   std::uint64_t settled = 0, unresolved = 0, invalid = 0;
   std::uint64_t bounces = 0;  // impacts over all tosses
+  RunCorrections corrections;  // guards and fallbacks over all tosses
 
   std::uint64_t total() const { return settled + unresolved + invalid; }
   void add(const TossResult& r);
