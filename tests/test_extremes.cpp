@@ -94,6 +94,14 @@ TEST(Extremes, EveryFidelityEndsEveryTossWithoutNaN) {
           ASSERT_GE(r.face_index, 0);
           ASSERT_LT(r.face_index, 6);
         }
+        // Every impact and every fixed step of `impulse`'s sustained contact and of `stepped`:
+        // the largest relative energy gain, kinetic across an impact, kinetic + m g z across a
+        // step (the traces above hold only `impulse`'s flight impacts).
+        EXPECT_LE(probe.max_energy_gain, 1e-12) << to_string(f) << ", " << x.name << ", toss " << i;
+        if (f == Fidelity::Impulse || f == Fidelity::Stepped) {
+          EXPECT_EQ(r.corrections.energy_clamps, 0u) << to_string(f) << ", " << x.name << ", toss " << i;
+          EXPECT_EQ(r.corrections.overlap_fixes, 0u) << to_string(f) << ", " << x.name << ", toss " << i;
+        }
         for (const BounceRecord& b : trace) {
           ASSERT_TRUE(b.after.velocity.allFinite() && b.after.omega.allFinite()) << x.name;
           EXPECT_LE(kinetic_energy(m, b.after), kinetic_energy(m, b.before) * (1.0 + 1e-12) + 1e-300)

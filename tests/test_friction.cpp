@@ -165,3 +165,205 @@ TEST(Friction, SlidingDieDeceleratesAtMuG) {
     EXPECT_NEAR(s.velocity.y(), 0.0, 1e-12);
   }
 }
+
+namespace {
+
+// A random state of `m` resting on 1, 2, 3 or 4 corners of its -z face (3: three of the four
+// corners of that face, passed as the contact set; the solver only sees the set), approaching.
+// The cube is tilted about x and y so that exactly those corners are lowest: k = 1 a corner,
+// k = 2 an edge, k = 3, 4 the face.
+struct Landing {
+  RigidState s;
+  ContactSet c;
+};
+
+Landing landing(const DieModel& m, TossRandom& rng, int k, double spin) {
+  Landing l;
+  // Body frame = principal frame; the geometric frame's -z face is where we land. Tilts: none for
+  // a face, about the x axis for an edge, about x and y for a corner.
+  const double tilt = 0.3;
+  Mat3 tilt_R = Mat3::Identity();
+  if (k == 2) tilt_R = Eigen::AngleAxisd(tilt, Vec3::UnitX()).toRotationMatrix();
+  if (k == 1) tilt_R = (Eigen::AngleAxisd(tilt, Vec3::UnitX()) * Eigen::AngleAxisd(0.2, Vec3::UnitY())).toRotationMatrix();
+  l.s.R = tilt_R * m.geo_to_body.transpose();
+  double low = 0.0;
+  for (const Vec3& v : m.vertices) low = std::min(low, (l.s.R * v).z());
+  l.s.position = Vec3(0, 0, -low);
+  l.s.velocity = Vec3(rng.normal(), rng.normal(), -0.2 - 3.0 * rng.uniform());
+  l.s.omega = spin * Vec3(rng.normal(), rng.normal(), rng.normal());
+  l.c = touching_corners(m, l.s, 1e-9 * m.bounding_radius);
+  if (k == 3 && l.c.n == 4) l.c.n = 3;
+  return l;
+}
+
+DieModel cube_model(double e, double mu) {
+  SceneDef s = fair_scene();
+  for (auto& [name, mat] : s.materials) {
+    mat.restitution = e;
+    mat.friction = mu;
+  }
+  return compile(s);
+}
+
+}  // namespace
+
+// Issue 13: no impact gains kinetic energy, for one to four contact points, e in {0, 0.5, 0.9, 1},
+// mu in {0, 0.3, 2}, spin up to 50 rad/s, on a homogeneous cube and Die 1's slab layout, and the
+// energy guard (now an assertion) never fires. Before, the one-corner sticking branch
+// (P_I + e P_In n) gained energy in ~28% (e = 0.9) to ~72% (e = 1) of sticking impacts, which the
+// guard then scaled back: this test fails on that code (energy_clamps > 0).
+TEST(FrictionImpact, EnergyNeverRisesForOneToFourContacts) {
+  int impacts = 0, clamps = 0, gained = 0, fallbacks = 0;
+  for (int layout = 0; layout < 2; ++layout)
+    for (double e : {0.0, 0.5, 0.9, 1.0})
+      for (double mu : {0.0, 0.3, 2.0}) {
+        const DieModel m = layout == 0 ? cube_model(e, mu) : slab_model(e, mu, 0.5);
+        TossRandom rng(21, static_cast<std::uint64_t>(layout * 1000 + e * 100 + mu * 10));
+        for (int k = 1; k <= 4; ++k)
+          for (int trial = 0; trial < 300; ++trial) {
+            Landing l = landing(m, rng, k, trial % 2 ? 50.0 : 5.0);
+            ASSERT_EQ(l.c.n, k);
+            const double e0 = kinetic_energy(m, l.s);
+            const ImpactResult r = apply_friction_impact(m, l.s, l.c, true);
+            ASSERT_TRUE(l.s.velocity.allFinite() && l.s.omega.allFinite());
+            ++impacts;
+            clamps += static_cast<int>(r.corrections.energy_clamps);
+            fallbacks += static_cast<int>(r.corrections.fallbacks);
+            if (kinetic_energy(m, l.s) > e0 * (1.0 + 1e-12)) ++gained;
+            // e = 1 and mu = 0 at one point: the Newton impulse, elastic. (Several points may lose
+            // energy even then: a restitution impulse that tips a neighbour into the floor is
+            // followed by a plastic impact of that neighbour.)
+            if (e == 1.0 && mu == 0.0 && k == 1) EXPECT_NEAR(kinetic_energy(m, l.s), e0, 1e-12 * e0);
+          }
+      }
+  EXPECT_EQ(gained, 0) << "of " << impacts;
+  EXPECT_EQ(clamps, 0) << "of " << impacts;
+  // Frictionless rescues (a multi-point solve with mu = 2 that did not converge left a point
+  // approaching): counted, and rare (measured: 165 of 28 800, mostly at mu = 2).
+  EXPECT_LE(fallbacks, impacts / 100) << "of " << impacts;
+}
+
+// One corner, sticking, e = 1: the old Chatterjee-Ruina branch gained energy here. Now the
+// restitution returns exactly e^2 of the normal work of compression, capped by what compression
+// removed, so with e = 1 and a sticking corner the energy after is at most the energy before and
+// the corner separates.
+TEST(FrictionImpact, StickingCornerWithFullRestitutionSeparatesWithoutGain) {
+  const DieModel m = cube_model(1.0, 2.0);  // mu = 2: nearly every corner sticks
+  TossRandom rng(22, 0);
+  int sticking = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    Landing l = landing(m, rng, 1, 20.0);
+    const Vec3 u0 = corner_velocity(m, l.s, l.c.vertex[0]);
+    if (u0.z() >= 0.0) continue;
+    const double e0 = kinetic_energy(m, l.s);
+    ContactImpulses P;
+    const ImpactResult r = apply_friction_impact(m, l.s, l.c, true, nullptr, &P);
+    EXPECT_EQ(r.corrections.energy_clamps, 0u);
+    EXPECT_LE(kinetic_energy(m, l.s), e0 * (1.0 + 1e-12));
+    EXPECT_GE(corner_velocity(m, l.s, l.c.vertex[0]).z(), 0.0);
+    ASSERT_EQ(P.n, 1);
+    EXPECT_LE(std::hypot(P.P[0].x(), P.P[0].y()), 2.0 * P.P[0].z() * (1.0 + 1e-9));
+    ++sticking;
+  }
+  EXPECT_GT(sticking, 1000);
+}
+
+// Coulomb's law at every contact of 2-, 3- and 4-point impacts: the impulse at each point lies in
+// its friction cone (compression and restitution together); after a plastic solve no point
+// approaches, a loaded point does not separate (complementarity), and where a point still slips
+// its friction is on the cone's edge and opposite the slip (maximal dissipation).
+TEST(FrictionImpact, CoulombAtEveryContactOfMultiPointImpacts) {
+  int checked = 0, slipping = 0;
+  for (double mu : {0.1, 0.3, 2.0}) {
+    int unconverged = 0, solves = 0;
+    const DieModel m = cube_model(0.5, mu);
+    TossRandom rng(23, static_cast<std::uint64_t>(mu * 10));
+    for (int k = 2; k <= 4; ++k)
+      for (int trial = 0; trial < 300; ++trial)
+        for (bool restitution : {true, false}) {
+          Landing l = landing(m, rng, k, 10.0);
+          ContactImpulses P;
+          const double scale = l.s.velocity.norm() + l.s.omega.norm() * m.bounding_radius;
+          const ImpactResult r = apply_friction_impact(m, l.s, l.c, restitution, nullptr, &P);
+          ASSERT_EQ(P.n, k);
+          ++solves;
+          // Gauss-Seidel may stop at its sweep cap where friction couples strongly into the
+          // normal direction (counted, reported; bounded below); Coulomb is asserted on the rest.
+          if (r.corrections.pgs_unconverged || r.corrections.fallbacks) {
+            ++unconverged;
+            continue;
+          }
+          for (int i = 0; i < k; ++i) {
+            const Vec3& p = P.P[i];
+            const double pt = std::hypot(p.x(), p.y());
+            EXPECT_GE(p.z(), 0.0);
+            EXPECT_LE(pt, mu * p.z() * (1.0 + 1e-9) + 1e-15) << k << " points, point " << i;
+            const Vec3 u = corner_velocity(m, l.s, l.c.vertex[i]);
+            EXPECT_GE(u.z(), -1e-9 * scale);
+            if (restitution) continue;
+            if (p.z() > 1e-9 * m.mass * scale) EXPECT_LE(std::abs(u.z()), 1e-9 * scale);  // loaded: stays on the floor
+            const double slip = std::hypot(u.x(), u.y());
+            if (slip > 1e-6 * scale && p.z() > 1e-6 * m.mass * scale) {
+              ++slipping;
+              EXPECT_NEAR(pt, mu * p.z(), 1e-6 * mu * p.z());
+              EXPECT_LT((p.x() * u.x() + p.y() * u.y()) / (pt * slip), -1.0 + 1e-6);
+            }
+          }
+          ++checked;
+        }
+    // Measured (of 1800 solves each): mu 0.3 -> 38 (2.1%); mu 2 -> under 20%.
+    EXPECT_LE(unconverged, mu < 1.0 ? solves * 3 / 100 : solves / 5) << "mu " << mu;
+  }
+  EXPECT_GT(slipping, checked / 10);  // the sliding case is really exercised
+}
+
+// Mixed materials (Die 1: steel corners e = 0.487, aluminium e = 0.550): the result does not
+// depend on the order in which the touching corners are listed (the order of the Gauss-Seidel
+// sweep). One e for the impact, weighted by each point's approach speed (a function of the state),
+// and symmetric sweeps converged to 1e-11.
+TEST(FrictionImpact, MultiContactResultDoesNotDependOnContactOrder) {
+  // Friction on a face (4 coplanar points) has no unique solution (the load's split, and with it
+  // each point's friction capacity, is free): there only the frictionless law is order-free.
+  // Edges (2 points) have a unique plastic frictional solution.
+  const DieModel m = compile(slab_scene(0.5));
+  SceneDef frictionless = slab_scene(0.5);
+  for (auto& [name, mat] : frictionless.materials) mat.friction = 0.0;
+  const DieModel m0 = compile(frictionless);
+  TossRandom rng(24, 0);
+  int compared = 0, unconverged = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    // An edge or a face of the slab die that has both materials on it: tilt about the body axis
+    // across the slabs.
+    RigidState s;
+    const double a = 0.5 * (rng.uniform() - 0.5);
+    // The geometric y face down (it spans both slabs), tilted onto its edge along geometric z.
+    s.R = (Eigen::AngleAxisd(trial % 2 ? a : 0.0, Vec3::UnitY()) * Eigen::AngleAxisd(kPi / 2, Vec3::UnitX())).toRotationMatrix() *
+          m.geo_to_body.transpose();
+    double low = 0.0;
+    for (const Vec3& v : m.vertices) low = std::min(low, (s.R * v).z());
+    s.position = Vec3(0, 0, -low);
+    s.velocity = Vec3(rng.normal(), rng.normal(), -0.5 - 2.0 * rng.uniform());
+    s.omega = 10.0 * Vec3(rng.normal(), rng.normal(), rng.normal());
+    ContactSet c = touching_corners(m, s, 1e-9 * m.bounding_radius);
+    if (c.n < 2) continue;
+    bool mixed = false;
+    for (int i = 1; i < c.n; ++i) mixed = mixed || m.vertex_restitution[c.vertex[i]] != m.vertex_restitution[c.vertex[0]];
+    ASSERT_TRUE(mixed);
+    const DieModel& mm = c.n > 2 ? m0 : m;
+    RigidState s1 = s, s2 = s;
+    const ImpactResult r1 = apply_friction_impact(mm, s1, c, true);
+    ContactSet rev = c;
+    for (int i = 0; i < c.n; ++i) rev.vertex[i] = c.vertex[c.n - 1 - i];
+    const ImpactResult r2 = apply_friction_impact(mm, s2, rev, true);
+    if (r1.corrections.any() || r2.corrections.any()) {
+      ++unconverged;
+      continue;
+    }
+    const double scale = s.velocity.norm() + s.omega.norm() * m.bounding_radius;
+    EXPECT_LE((s1.velocity - s2.velocity).norm(), 1e-9 * scale) << c.n << " points";
+    EXPECT_LE((s1.omega - s2.omega).norm() * m.bounding_radius, 1e-9 * scale) << c.n << " points";
+    ++compared;
+  }
+  EXPECT_GT(compared, 300);
+  EXPECT_LE(unconverged, 8);
+}

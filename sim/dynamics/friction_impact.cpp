@@ -16,7 +16,9 @@ Mat3 skew(const Vec3& r) {
 }
 
 // Sweep caps of the Gauss-Seidel solves; reaching one is counted (pgs_unconverged).
-constexpr int kMaxSweeps = 200;
+constexpr int kMaxSweeps = 400;
+// Sweeps with the cheap tangential update before the exact one takes over.
+constexpr int kCheapSweeps = 30;
 // Converged when a whole sweep changed the body's velocity (v, and w times the bounding radius)
 // by less than this fraction of the speeds involved. (A test on the impulses would never pass on a
 // face, whose split of the load over its corners is not unique; the velocities are.)
@@ -284,10 +286,13 @@ SweepResult solve_plastic(const Body& b, const Points& pts, double pn[], Eigen::
       // Tangential: the sticking update, or on the cone's edge opposite the slip (whose fixed
       // points are the same Coulomb law as the exact disc minimiser's, at a fraction of the cost).
       const Eigen::Vector2d slip(u.x(), u.y());
-      Eigen::Vector2d t = pt[i] - pts.inv_wtt[i] * slip;
       const double limit = pts.mu[i] * pn[i];
-      const double tn = t.norm();
-      if (tn > limit) {
+      Eigen::Vector2d t = pt[i] - pts.inv_wtt[i] * slip;
+      if (it >= kCheapSweeps) {
+        // Slow to converge (strong coupling of slip and normal): the exact minimiser of the
+        // kinetic energy over the disc, a true block-coordinate descent.
+        t = min_on_disc(pts.wtt[i], slip - pts.wtt[i] * pt[i], limit);
+      } else if (const double tn = t.norm(); tn > limit) {
         const double sn = slip.norm();
         t = sn > 0.0 ? Eigen::Vector2d(-limit * slip / sn) : Eigen::Vector2d(t * (limit / tn));
       }
