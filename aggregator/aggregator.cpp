@@ -54,6 +54,14 @@ void Aggregator::on_message(std::string_view channel, const void* data, std::siz
 bool Aggregator::valid_batch(const dicesim_lcm::toss_batch& b) const {
   const std::size_t n = static_cast<std::size_t>(b.count);
   if (b.count < 1 || b.faces.size() != n || b.statuses.size() != n || b.bounces.size() != n) return false;
+  const std::size_t nc = static_cast<std::size_t>(b.n_corrected);
+  if (b.n_corrected < 0 || b.corrected_offset.size() != nc || b.energy_clamps.size() != nc ||
+      b.pgs_unconverged.size() != nc || b.overlap_fixes.size() != nc || b.fallbacks.size() != nc)
+    return false;
+  for (std::size_t j = 0; j < nc; ++j)
+    if (b.corrected_offset[j] < 0 || b.corrected_offset[j] >= b.count || b.energy_clamps[j] < 0 || b.pgs_unconverged[j] < 0 ||
+        b.overlap_fixes[j] < 0 || b.fallbacks[j] < 0)
+      return false;
   for (std::size_t k = 0; k < n; ++k) {
     const int face = b.faces[k], status = b.statuses[k];
     if (b.bounces[k] < 0) return false;
@@ -116,6 +124,15 @@ void Aggregator::ingest(std::uint64_t first, std::uint64_t lo, std::uint64_t hi,
         default: ++c.invalid; break;
       }
       c.bounces += static_cast<std::uint64_t>(b.bounces[k]);
+    }
+    // Corrections of the tosses in [lo, end) (only fresh indices reach here: no double counting).
+    for (std::size_t j = 0; j < b.corrected_offset.size(); ++j) {
+      const std::uint64_t i = first + static_cast<std::uint64_t>(b.corrected_offset[j]);
+      if (i < lo || i >= end) continue;
+      c.corrections.energy_clamps += static_cast<std::uint64_t>(b.energy_clamps[j]);
+      c.corrections.pgs_unconverged += static_cast<std::uint64_t>(b.pgs_unconverged[j]);
+      c.corrections.overlap_fixes += static_cast<std::uint64_t>(b.overlap_fixes[j]);
+      c.corrections.fallbacks += static_cast<std::uint64_t>(b.fallbacks[j]);
     }
     blocks_[block].merge(c);
     all_.merge(c);
@@ -324,6 +341,10 @@ dicesim_lcm::probabilities Aggregator::snapshot() const {
   m.rejected_malformed = static_cast<std::int64_t>(health_.malformed);
   m.rejected_range = static_cast<std::int64_t>(health_.range);
   m.released = static_cast<std::int64_t>(health_.released);
+  m.corrections[0] = static_cast<std::int64_t>(c.corrections.energy_clamps);
+  m.corrections[1] = static_cast<std::int64_t>(c.corrections.pgs_unconverged);
+  m.corrections[2] = static_cast<std::int64_t>(c.corrections.overlap_fixes);
+  m.corrections[3] = static_cast<std::int64_t>(c.corrections.fallbacks);
   return m;
 }
 

@@ -71,7 +71,9 @@ bool plausible_run_start(const void* data, std::size_t len) {
 bool plausible_toss_batch(const void* data, std::size_t len) {
   Walker w(data, len);
   std::int32_t n = 0;
-  return w.skip(8 + 5 * 8) && w.count(n, 6) && n <= kMaxBatch && w.skip(static_cast<std::size_t>(n) * 6) && w.at_end();
+  std::int32_t corrected = 0;  // tosses with corrections: offset and four counts, 20 bytes each
+  return w.skip(8 + 5 * 8) && w.count(n, 6) && n <= kMaxBatch && w.skip(static_cast<std::size_t>(n) * 6) &&
+         w.count(corrected, 20) && corrected <= n && w.skip(static_cast<std::size_t>(corrected) * 20) && w.at_end();
 }
 
 bool plausible_worker_status(const void* data, std::size_t len) {

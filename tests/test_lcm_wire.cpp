@@ -38,6 +38,24 @@ TEST(LcmWire, TossBatchRoundTripsAndStaysOneDatagram) {
   EXPECT_EQ(d->first_index, 100);
   EXPECT_EQ(d->faces, b.faces);
   EXPECT_EQ(d->bounces, b.bounces);
+  EXPECT_EQ(d->n_corrected, 0);
+}
+
+// The corrections of the few tosses that had any (issue 13) travel with their offsets.
+TEST(LcmWire, TossBatchCarriesCorrections) {
+  auto b = sample_batch(10);
+  b.n_corrected = 2;
+  b.corrected_offset = {3, 7};
+  b.energy_clamps = {0, 0};
+  b.pgs_unconverged = {2, 1};
+  b.overlap_fixes = {0, 0};
+  b.fallbacks = {1, 0};
+  const auto bytes = w::encode(b);
+  const auto d = w::decode<dicesim_lcm::toss_batch>(bytes.data(), bytes.size());
+  ASSERT_TRUE(d.has_value());
+  EXPECT_EQ(d->corrected_offset, b.corrected_offset);
+  EXPECT_EQ(d->pgs_unconverged, b.pgs_unconverged);
+  EXPECT_EQ(d->fallbacks, b.fallbacks);
 }
 
 TEST(LcmWire, EveryTruncationOfEveryTypeIsRejected) {

@@ -374,7 +374,9 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
   res.energy_before = E0;
   // The speeds involved (convergence and rounding tests are relative to it).
   const double lever = m.bounding_radius;
-  const double speed = s0.velocity.norm() + s0.omega.norm() * lever;
+  // (Plus a floor, 1e-2 of the tolerance at the die's natural speed sqrt(g r), where the speeds
+  // are so small, a die at rest, that rounding would keep the sweep from ever meeting them.)
+  const double speed = s0.velocity.norm() + s0.omega.norm() * lever + 1e-2 * std::sqrt(m.gravity * lever);
 
   // 1. Compression: the plastic frictional impulse.
   double pn[kMaxContacts];

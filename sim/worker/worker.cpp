@@ -167,6 +167,7 @@ bool WorkerCore::step(double now) {
   b.faces.resize(n);
   b.statuses.resize(n);
   b.bounces.resize(n);
+  b.n_corrected = 0;
   std::vector<BounceRecord> records;
   for (std::uint64_t k = 0; k < n; ++k) {
     const std::uint64_t i = l.next + k;
@@ -179,6 +180,14 @@ bool WorkerCore::step(double now) {
     b.faces[k] = static_cast<std::int8_t>(r.status == TossStatus::Settled ? r.face : 0);
     b.statuses[k] = static_cast<std::int8_t>(r.status);
     b.bounces[k] = r.bounces;
+    if (r.corrections.any()) {
+      ++b.n_corrected;
+      b.corrected_offset.push_back(static_cast<std::int32_t>(k));
+      b.energy_clamps.push_back(static_cast<std::int32_t>(r.corrections.energy_clamps));
+      b.pgs_unconverged.push_back(static_cast<std::int32_t>(r.corrections.pgs_unconverged));
+      b.overlap_fixes.push_back(static_cast<std::int32_t>(r.corrections.overlap_fixes));
+      b.fallbacks.push_back(static_cast<std::int32_t>(r.corrections.fallbacks));
+    }
     for (const BounceRecord& rec : records) {
       if (trace_tokens_ < 1.0) {
         ++traces_skipped_;
