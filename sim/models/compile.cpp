@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
+#include "sim/body/body.hpp"
 #include "sim/models/fidelity_auto.hpp"
 #include "sim/dynamics/rest.hpp"
 #include "sim/scene/scene_error.hpp"
@@ -12,92 +14,39 @@
 namespace dicesim {
 namespace {
 
-std::string region_key(std::size_t k) { return "die.regions[" + std::to_string(k) + "]"; }
-
 std::string fmt(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.6g", v);
   return buf;
 }
 
-// Regions must each cover some of the box and must not overlap: the density field is then
-// unambiguous, and mass properties are the exact sum over regions.
-void check_regions(const DieDef& die, const std::string& origin) {
-  const double box_volume = die.size.prod();
-  const double tiny = 1e-9 * box_volume;
-  for (std::size_t k = 0; k < die.regions.size(); ++k) {
-    if (clipped_box_moments(die.size, die.regions[k].half_spaces).volume <= tiny)
-      throw SceneError(origin, region_key(k) + ".cuts", "", "the cuts leave no part of the die for this region");
-    for (std::size_t j = 0; j < k; ++j) {
-      std::vector<HalfSpace> both = die.regions[j].half_spaces;
-      both.insert(both.end(), die.regions[k].half_spaces.begin(), die.regions[k].half_spaces.end());
-      if (clipped_box_moments(die.size, both).volume > tiny)
-        throw SceneError(origin, region_key(k) + ".cuts", "",
-                         "overlaps " + region_key(j) + "; regions must not overlap");
-    }
-  }
-}
-
-// A corner's material: the volume-weighted mix of the materials in a small cube at that corner
-// (a cut through a corner, as the seed's Die 3 has, gives a mix instead of an arbitrary pick).
-void corner_materials(const DieDef& die, const std::map<std::string, MaterialDef>& materials, int corner,
-                      double& restitution, double& friction) {
-  const Vec3 half = 0.5 * die.size;
-  const double eps = 1e-6 * die.size.minCoeff();
-  Vec3 lo, hi;
-  for (int a = 0; a < 3; ++a) {
-    const bool plus = (corner >> a) & 1;
-    lo[a] = plus ? half[a] - eps : -half[a];
-    hi[a] = plus ? half[a] : -half[a] + eps;
-  }
-  const double v = (hi - lo).prod();
-  double base_fraction = 1.0;
-  restitution = friction = 0.0;
-  for (const RegionDef& r : die.regions) {
-    const double f = clipped_aabb_moments(lo, hi, r.half_spaces).volume / v;
-    if (f <= 0.0) continue;
-    base_fraction -= f;
-    restitution += f * materials.at(r.material).restitution;
-    friction += f * materials.at(r.material).friction;
-  }
-  base_fraction = std::max(0.0, base_fraction);
-  restitution += base_fraction * materials.at(die.base_material).restitution;
-  friction += base_fraction * materials.at(die.base_material).friction;
-}
-
 }  // namespace
 
 DieModel compile(const SceneDef& scene, const std::string& origin) {
-  const DieDef& die = scene.die;
-  check_regions(die, origin);
+  const Body body = build_body(scene, origin);
+  if (body.shape.vertices.size() != 8 || body.shape.faces.size() != 6)
+    throw SceneError(origin, "die.shape", body.kind, "only a six-faced box can be simulated yet");
 
   DieModel m;
   m.name = scene.name;
-  m.mass_geometric = compute_mass_properties(die, scene.materials);
+  m.mass_geometric = body.mass;
   const MassProperties& mp = m.mass_geometric;
-  if (!(mp.mass > 0.0) || !mp.inertia.allFinite())
-    throw SceneError(origin, "die", "", "the die has no mass; check die.size and the densities");
 
   m.mass = mp.mass;
   m.principal_moments = mp.principal_moments;
   m.geo_to_body = mp.principal_axes.transpose();
   m.symmetric_top = is_symmetric_top(m.principal_moments);
 
-  const Vec3 half = 0.5 * die.size;
   for (int c = 0; c < 8; ++c) {
-    Vec3 corner;
-    for (int a = 0; a < 3; ++a) corner[a] = ((c >> a) & 1) ? half[a] : -half[a];
-    m.vertices[c] = m.geo_to_body * (corner - mp.com);
-    corner_materials(die, scene.materials, c, m.vertex_restitution[c], m.vertex_friction[c]);
-    if (scene.floor.restitution) m.vertex_restitution[c] = *scene.floor.restitution;
+    m.vertices[c] = m.geo_to_body * (body.shape.vertices[c] - mp.com);
+    m.vertex_restitution[c] = scene.floor.restitution ? *scene.floor.restitution : body.vertex_restitution[c];
+    m.vertex_friction[c] = body.vertex_friction[c];
     m.bounding_radius = std::max(m.bounding_radius, m.vertices[c].norm());
   }
   for (int f = 0; f < 6; ++f) {
-    Vec3 n = Vec3::Zero();
-    n[f / 2] = (f % 2 == 0) ? 1.0 : -1.0;
-    m.face_normals[f] = m.geo_to_body * n;
+    m.face_normals[f] = m.geo_to_body * body.shape.normals[f];
+    m.face_labels[f] = body.face_labels[f];
   }
-  m.face_labels = die.face_labels;
 
   compute_rest_geometry(m);
   m.max_friction = *std::max_element(m.vertex_friction.begin(), m.vertex_friction.end());
