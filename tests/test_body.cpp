@@ -382,3 +382,56 @@ TEST(BodyErrors, ObjThatDoesNotParseOrIsNotClosedNamesTheLine) {
 
 }  // namespace
 }  // namespace dicesim
+
+// ---- Ready scenes (scenes/dice/) ---------------------------------------------------------------
+namespace dicesim {
+namespace {
+
+Body ready(const std::string& name) {
+  const std::string path = std::string(DICESIM_SOURCE_DIR) + "/scenes/dice/" + name;
+  return build_body(load_scene(path), path);
+}
+
+TEST(BodyReadyScenes, EveryDiceSceneBuilds) {
+  struct Case {
+    const char* file;
+    std::size_t faces;
+    bool read_down;
+    double rounding;
+  };
+  const Case cases[] = {{"d4.toml", 4, true, 0.0},          {"d6.toml", 6, false, 0.0015},
+                        {"d8.toml", 8, false, 0.0},         {"d10.toml", 10, false, 0.0},
+                        {"d12.toml", 12, false, 0.0},       {"d20.toml", 20, false, 0.0},
+                        {"loaded-d20.toml", 20, false, 0.0}, {"steel-cuboid.toml", 6, false, 0.0},
+                        {"prism3.toml", 5, true, 0.0}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.file);
+    const Body b = ready(c.file);
+    EXPECT_EQ(b.shape.faces.size(), c.faces);
+    EXPECT_EQ(b.read_down, c.read_down);
+    EXPECT_EQ(b.shape.rounding, c.rounding);
+    expect_well_formed(b.shape);
+    EXPECT_GT(b.mass.mass, 0.0);
+  }
+}
+
+TEST(BodyReadyScenes, LoadedD20IsHeavyTowardsItsSlabFace) {
+  const Body fair = ready("d20.toml");
+  const Body loaded = ready("loaded-d20.toml");
+  const double phi = (1.0 + std::sqrt(5.0)) / 2.0;
+  const Vec3 n = Vec3(1.0 / phi, 0.0, -phi).normalized();
+  EXPECT_LE(fair.mass.com.norm(), 1e-15);
+  // The slab (steel in n.x >= 8 mm) pulls the COM towards the face with normal n.
+  EXPECT_GT(loaded.mass.com.dot(n), 1e-4);
+  EXPECT_LE((loaded.mass.com - loaded.mass.com.dot(n) * n).norm(), 1e-12) << "and only along n";
+  EXPECT_NEAR(loaded.shape.normals[nearest_face(loaded.shape, n)].dot(n), 1.0, 1e-12) << "n is a face normal";
+  EXPECT_GT(loaded.mass.mass, fair.mass.mass);
+  EXPECT_EQ(loaded.face_labels[nearest_face(loaded.shape, n)], 19) << "as the scene says";
+  EXPECT_EQ(loaded.face_labels[nearest_face(loaded.shape, -n)], 2);
+  // Its contact corners are steel (those of the slab face) or plastic.
+  const int f = nearest_face(loaded.shape, n);
+  for (int v : loaded.shape.faces[f]) EXPECT_NEAR(loaded.vertex_restitution[v], 0.6, 1e-12);
+}
+
+}  // namespace
+}  // namespace dicesim
