@@ -39,23 +39,23 @@ def timed(f):
 
 
 def test_tosses_in_two_threads_overlap(dicesim, die1):
-    """The deterministic proof: with the GIL held during a run, two runs could not overlap in time."""
+    """The proof that holds on a busy machine too: two runs, each timed inside the module, fit into
+    a wall-clock window much shorter than their sum, so they ran at the same time. With the GIL
+    held during a run they could only run one after the other (window >= sum)."""
     n = 100000
-    spans = []
+    elapsed = []
 
     def run():
-        r = dicesim.toss(die1, n, threads=1)
-        end = time.perf_counter()
-        spans.append((end - r.elapsed_s, end))
+        elapsed.append(dicesim.toss(die1, n, threads=1).elapsed_s)
 
     ts = [threading.Thread(target=run) for _ in range(2)]
+    t0 = time.perf_counter()
     for t in ts:
         t.start()
     for t in ts:
         t.join()
-    (a0, a1), (b0, b1) = spans
-    overlap = min(a1, b1) - max(a0, b0)
-    assert overlap > 0.5 * min(a1 - a0, b1 - b0), spans
+    window = time.perf_counter() - t0
+    assert window < 0.75 * sum(elapsed), (window, elapsed)
 
 
 def test_two_threads_toss_in_parallel(dicesim, die1):
