@@ -131,7 +131,6 @@ void register_scene(pb::module_& m) {
       "load_scene",
       [](const std::string& path, const pb::object& set) { return Scene::from_path(path, overrides_of(set)); },
       pb::arg("path"), pb::arg("set") = pb::none(),
-      "load_scene(path, set=None) -> Scene\n\n"
       "Reads a scene file (TOML), applies the overrides in `set` and compiles the die.\n"
       "`set` is a dict {\"materials.steel.restitution\": 0.9, \"sim.fidelity\": \"impulse\"} or a list of\n"
       "'KEY=VALUE' texts: each is the command line's `--set KEY=VALUE` (numbers, bools and lists are\n"
@@ -143,7 +142,6 @@ void register_scene(pb::module_& m) {
         return Scene::from_text(text, name, overrides_of(set));
       },
       pb::arg("text"), pb::arg("set") = pb::none(), pb::arg("name") = "<string>",
-      "scene_from_toml(text, set=None, name='<string>') -> Scene\n\n"
       "The same as load_scene() for TOML text in memory; `name` stands for the file in errors and\n"
       "reports; `extends` paths are relative to the current directory.");
 }

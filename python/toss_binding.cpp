@@ -272,7 +272,6 @@ void register_toss(pb::module_& m) {
 
   m.def("toss", &do_toss, pb::arg("scene"), pb::arg("n") = pb::none(), pb::arg("seed") = 1, pb::arg("threads") = 0,
         pb::arg("fidelity") = pb::none(), pb::arg("target_halfwidth") = pb::none(), pb::arg("progress") = pb::none(),
-        "toss(scene, n=None, seed=1, threads=0, fidelity=None, target_halfwidth=None, progress=None) -> Result\n\n"
         "Tosses the die n times (default 100000) and returns the counts per face: `dicesim toss`.\n"
         "Toss i draws its throw from (seed, i) only, so the same scene, fidelity, seed and n give\n"
         "the same counts as the command line, on any number of threads.\n\n"
@@ -311,8 +310,6 @@ void register_toss(pb::module_& m) {
   m.def("sweep", &do_sweep, pb::arg("scene"), pb::arg("key"), pb::arg("values"), pb::arg("n"), pb::arg("seed") = 1,
         pb::arg("threads") = 0, pb::arg("fidelity") = pb::none(), pb::arg("template") = "{}", pb::arg("scale") = 1.0,
         pb::arg("shift") = 0.0, pb::arg("progress") = pb::none(),
-        "sweep(scene, key, values, n, seed=1, threads=0, fidelity=None, template='{}', scale=1.0,\n"
-        "      shift=0.0, progress=None) -> Sweep\n\n"
         "P(face) of the scene at each value of one key: `dicesim sweep SCENE --param KEY --values ...`.\n"
         "Every point is the scene with one more override KEY=VALUE, where VALUE is `template` with\n"
         "'{}' replaced by scale * x + shift, tossed n times with the same seed and toss indices.\n"

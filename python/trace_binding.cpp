@@ -125,7 +125,6 @@ pb::dict toss_one(Scene& scene, std::uint64_t index, std::uint64_t seed, std::op
 void register_trace(pb::module_& m) {
   m.def("toss_one", &toss_one, pb::arg("scene"), pb::arg("index"), pb::arg("seed") = 1, pb::arg("fidelity") = pb::none(),
         pb::arg("trace") = true,
-        "toss_one(scene, index, seed=1, fidelity=None, trace=True) -> dict\n\n"
         "Toss number `index` of a run with `seed` (the same toss that run makes), with its impacts:\n"
         "  face, face_index, status ('settled'/'unresolved'/'invalid'), bounces, t_end (s),\n"
         "  mass (kg), gravity (m/s^2), fidelity, index, seed;\n"
@@ -135,8 +134,9 @@ void register_trace(pb::module_& m) {
         "  impacts (None unless trace): one entry per impact, as numpy arrays: bounce, t (s since\n"
         "           release), vertex, impulse (N s), and before/after: {position (k,3), velocity (k,3),\n"
         "           R (k,3,3), omega (k,3), energy (k,)} at the instant of contact / right after it.\n"
-        "Energy is kinetic (translation and rotation) plus m g z, in J. Between impacts the centre\n"
-        "of mass flies ballistically: z(t) = z_i + vz_i (t - t_i) - g (t - t_i)^2 / 2.");
+        "Energy is kinetic (translation and rotation) plus m g z, in J. With fidelity 'paper' the\n"
+        "centre of mass flies ballistically between impacts: z(t) = z_i + vz_i (t - t_i) - g (t - t_i)^2 / 2\n"
+        "(the other fidelities also roll and slide in sustained contact between recorded impacts).");
 }
 
 }  // namespace dicesim::py
