@@ -92,6 +92,34 @@ RunReport make_report(const Scene& scene, const DieModel& model, std::uint64_t s
   return r;
 }
 
+// run_tosses checks `cancel` between chunks of n/64 tosses (64 to 16384): up to seconds for the
+// slow fidelities (a `stepped` toss takes milliseconds). Those run in consecutive blocks of 64
+// chunks of 64 tosses, so Ctrl-C stops them within one chunk; the indices are the same, so are the
+// counts. (A block's tail, when only one thread still works, costs under 1%.) `paper` and `static`
+// chunks last milliseconds: one run_tosses call, as the CLI makes.
+constexpr std::uint64_t kSlowBlock = 64 * 64;
+
+// Progress goes to `monitor` as (base + tosses done, monitor.total): `base` places a sweep's point.
+RunCounts run_cancellable(const DieModel& model, RunConfig cfg, RunMonitor& monitor, bool report, std::uint64_t base = 0) {
+  const std::uint64_t first = cfg.first, n = cfg.tosses;
+  cfg.cancel = &monitor.cancel;
+  const bool slow = model.fidelity == Fidelity::Impulse || model.fidelity == Fidelity::Stepped;
+  if (!slow) {
+    // run_tosses' reporter thread costs up to 100 ms at the end of a run: only when asked for.
+    if (report) cfg.progress = [&monitor, base](std::uint64_t d, std::uint64_t) { monitor.report(base + d, monitor.total); };
+    return run_tosses(model, cfg);
+  }
+  RunCounts total;
+  for (std::uint64_t done = 0; done < n && !monitor.cancel;) {
+    cfg.first = first + done;
+    cfg.tosses = std::min(kSlowBlock, n - done);
+    total.merge(run_tosses(model, cfg));
+    done += cfg.tosses;
+    monitor.report(base + done, monitor.total);
+  }
+  return total;
+}
+
 // Runs of at most one chunk of run_tosses (64 tosses) go on one thread anyway: they run on the
 // calling thread, without the GIL but also without the waiting loop (no thread to start: the
 // calling overhead stays in microseconds), and cannot be interrupted.
@@ -121,13 +149,15 @@ Result do_toss(Scene& scene, std::optional<std::uint64_t> n, std::uint64_t seed,
   } else {
     RunMonitor monitor;
     monitor.total = tosses;
-    cfg.cancel = &monitor.cancel;
-    // run_tosses' reporter thread costs up to 100 ms at the end of a run: only when asked for.
-    if (!progress.is_none()) cfg.progress = [&monitor](std::uint64_t d, std::uint64_t t) { monitor.report(d, t); };
     run_interruptible(
         [&] {
-          counts = target_halfwidth ? agg::run_to_target(*model, cfg, tosses, *target_halfwidth, done)
-                                    : run_tosses(*model, cfg);
+          if (target_halfwidth) {  // blocks of 10000 tosses: chunks of 156, prompt at any fidelity
+            cfg.cancel = &monitor.cancel;
+            if (!progress.is_none()) cfg.progress = [&monitor](std::uint64_t d, std::uint64_t t) { monitor.report(d, t); };
+            counts = agg::run_to_target(*model, cfg, tosses, *target_halfwidth, done);
+          } else {
+            counts = run_cancellable(*model, cfg, monitor, !progress.is_none());
+          }
         },
         monitor, progress);
   }
@@ -200,12 +230,8 @@ Sweep do_sweep(Scene& scene, const std::string& key, const pb::object& values, s
           cfg.first = 0;  // the same indices at every point: common random numbers
           cfg.tosses = n;
           cfg.threads = nthreads;
-          cfg.cancel = &monitor.cancel;
-          const std::uint64_t before = n * i;
-          if (!progress.is_none())
-            cfg.progress = [&monitor, before](std::uint64_t d, std::uint64_t) { monitor.report(before + d, monitor.total); };
-          counts[i] = run_tosses(models[i], cfg);
-          monitor.report(before + n, monitor.total);
+          counts[i] = run_cancellable(models[i], cfg, monitor, !progress.is_none(), n * i);
+          monitor.report(n * (i + 1), monitor.total);
           elapsed[i] = std::chrono::duration<double>(Clock::now() - ti).count();
         }
       },

@@ -17,7 +17,7 @@ def test_import_from_build_python_with_debian_python():
 @pytest.mark.parametrize("args", [
     dict(n=20000, seed=7, threads=2),
     dict(n=3000, seed=1, threads=1, fidelity="static"),
-    dict(n=500, seed=3, threads=2, fidelity="impulse"),
+    dict(n=4500, seed=3, threads=2, fidelity="impulse"),  # two blocks of the slow fidelities' loop
 ])
 def test_to_dict_is_cli_json(dicesim, args):
     scene = dicesim.load_scene(DIE1)
