@@ -7,11 +7,14 @@
     PYTHONPATH=build/python /usr/bin/python3 python/bench.py [--tosses 1000000] [--threads 2] [--repeat 3]
 
 Runs alternate (CLI, Python, CLI, Python, ...) so that both see the same machine load; the CLI's
-time is its own `elapsed_s` (the run, not the process start), as is the module's.
+time is its own `elapsed_s` (the run, not the process start), as is the module's. CPU seconds
+(all threads; the CLI's include its start and scene load) are printed too: on a machine shared
+with other work they vary far less than wall-clock times.
 """
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import time
@@ -43,20 +46,31 @@ def main():
     n, _ = t.autorange()
     print(f"toss(scene, 1).to_dict(): best {min(t.repeat(7, n)) / n * 1e6:.1f} us")
 
-    cli, py = [], []
+    cli, py, cli_cpu, py_cpu = [], [], [], []
+
+    def children_cpu():
+        u = resource.getrusage(resource.RUSAGE_CHILDREN)
+        return u.ru_utime + u.ru_stime
+
     for _ in range(args.repeat):
+        c0 = children_cpu()
         out = subprocess.run([args.cli, "toss", args.scene, "-n", str(args.tosses), "--threads", str(args.threads),
                               "--json"], capture_output=True, text=True, check=True).stdout
+        cli_cpu.append(children_cpu() - c0)
         c = json.loads(out)
         cli.append(c["elapsed_s"])
-        t0 = time.perf_counter()
+        t0, p0 = time.perf_counter(), time.process_time()
         r = dicesim.toss(scene, args.tosses, threads=args.threads)
         wall = time.perf_counter() - t0
+        py_cpu.append(time.process_time() - p0)
         py.append(r.elapsed_s)
         assert list(r.counts) == [f["count"] for f in c["faces"]], "counts differ from the CLI's"
-        print(f"  CLI {c['elapsed_s']:.3f} s   Python {r.elapsed_s:.3f} s (call {wall:.3f} s)")
+        print(f"  CLI {c['elapsed_s']:.3f} s ({cli_cpu[-1]:.3f} CPU s)   Python {r.elapsed_s:.3f} s "
+              f"({py_cpu[-1]:.3f} CPU s, call {wall:.3f} s)")
     print(f"{args.tosses} tosses, {args.threads} threads: CLI median {statistics.median(cli):.3f} s, "
           f"Python median {statistics.median(py):.3f} s, ratio {statistics.median(py) / statistics.median(cli):.3f}")
+    print(f"CPU seconds: CLI median {statistics.median(cli_cpu):.3f}, Python median {statistics.median(py_cpu):.3f}, "
+          f"ratio {statistics.median(py_cpu) / statistics.median(cli_cpu):.3f}")
     print("load:", os.getloadavg())
 
 

@@ -67,7 +67,11 @@ class Result:
 
 class Sweep:
     @property
+    def title(self) -> str: ...
+    @property
     def key(self) -> str: ...
+    @property
+    def point_labels(self) -> list[str]: ...
     @property
     def values(self) -> npt.NDArray[np.float64]: ...
     @property
@@ -105,5 +109,13 @@ def sweep(
     template: str = "{}",
     scale: float = 1.0,
     shift: float = 0.0,
+    progress: Progress = None,
+) -> Sweep: ...
+def sweep_file(
+    path: str,
+    n: Optional[int] = None,
+    seed: Optional[int] = None,
+    threads: int = 0,
+    fidelity: Optional[str] = None,
     progress: Progress = None,
 ) -> Sweep: ...

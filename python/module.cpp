@@ -70,8 +70,8 @@ PYBIND11_MODULE(dicesim, m) {
       "    r = dicesim.toss(scene, 100_000)\n"
       "    r.labels, r.counts, r.p, r.ci95    # numpy arrays, faces by label\n"
       "    r.to_dict()                        # exactly `dicesim toss --json`'s object\n\n"
-      "Functions: load_scene, scene_from_toml, toss, toss_one, sweep. Bad scene input raises\n"
-      "SceneError (a ValueError) with the message the command line prints.";
+      "Functions: load_scene, scene_from_toml, toss, toss_one, sweep, sweep_file. Bad scene input\n"
+      "raises SceneError (a ValueError) with the message the command line prints.";
   m.attr("__version__") = "0.1.0";
 
   // SceneError: a ValueError carrying the CLI's exit-2 message and its parts.

@@ -17,7 +17,7 @@ def test_import_from_build_python_with_debian_python():
 @pytest.mark.parametrize("args", [
     dict(n=20000, seed=7, threads=2),
     dict(n=3000, seed=1, threads=1, fidelity="static"),
-    dict(n=500, seed=3, threads=2, fidelity="impulse"),
+    dict(n=4500, seed=3, threads=2, fidelity="impulse"),  # two blocks of the slow fidelities' loop
 ])
 def test_to_dict_is_cli_json(dicesim, args):
     scene = dicesim.load_scene(DIE1)
@@ -128,7 +128,8 @@ def test_to_pandas(dicesim, die1):
 
 
 def test_help_and_docstrings(dicesim):
-    for f in (dicesim.load_scene, dicesim.scene_from_toml, dicesim.toss, dicesim.toss_one, dicesim.sweep):
+    for f in (dicesim.load_scene, dicesim.scene_from_toml, dicesim.toss, dicesim.toss_one, dicesim.sweep,
+              dicesim.sweep_file):
         assert f.__doc__ and len(f.__doc__) > 100
     assert "toss --json" in dicesim.Result.to_dict.__doc__
     assert issubclass(dicesim.SceneError, ValueError)
@@ -139,7 +140,7 @@ def test_stub_names_exist(dicesim):
     from conftest import SOURCE_DIR
     tree = ast.parse((SOURCE_DIR / "python/dicesim.pyi").read_text())
     names = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
-    assert names >= {"load_scene", "scene_from_toml", "toss", "toss_one", "sweep", "Scene", "Result", "Sweep",
-                     "SceneError"}
+    assert names >= {"load_scene", "scene_from_toml", "toss", "toss_one", "sweep", "sweep_file", "Scene", "Result",
+                     "Sweep", "SceneError"}
     for name in names:
         assert hasattr(dicesim, name), name

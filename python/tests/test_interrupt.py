@@ -25,7 +25,7 @@ def interrupt_after(delay):
     return sent
 
 
-@pytest.mark.parametrize("call", ["toss", "target", "sweep"])
+@pytest.mark.parametrize("call", ["toss", "target", "sweep", "stepped", "impulse-sweep"])
 def test_sigint_stops_a_long_run(dicesim, die1, call):
     threads_before = threading.active_count()
     sent = interrupt_after(0.3)
@@ -35,8 +35,12 @@ def test_sigint_stops_a_long_run(dicesim, die1, call):
             dicesim.toss(die1, 10**9, threads=2)
         elif call == "target":
             dicesim.toss(die1, 10**9, target_halfwidth=1e-6, threads=2)
-        else:
+        elif call == "sweep":
             dicesim.sweep(die1, "throw.height.mean", [0.5, 1.0], 10**9, threads=2)
+        elif call == "stepped":  # milliseconds per toss: run_tosses alone would stop after minutes
+            dicesim.toss(die1, 10**6, threads=2, fidelity="stepped")
+        else:
+            dicesim.sweep(die1, "throw.height.mean", [0.5, 1.0], 10**6, threads=2, fidelity="impulse")
     stopped = time.monotonic()
     assert sent, "the run ended before the signal"
     assert stopped - sent[0] < PROMPT_S

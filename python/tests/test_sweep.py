@@ -34,3 +34,15 @@ def test_sweep_to_pandas_long_form(dicesim, die1):
     assert len(df) == 2 * len(die1.labels)
     assert df.groupby("x")["count"].sum().tolist() == [r.settled for r in s.points]
     assert df.attrs["key"] == "throw.height.mean"
+
+
+def test_sweep_file_equals_the_cli(dicesim):
+    path = "scenes/paper/sweeps/volume-ratio.toml"
+    s = dicesim.sweep_file(path, n=200, threads=2)
+    cli = cli_json("sweep", path, "-n", "200")
+    assert s.title == cli["title"] and len(s) == len(cli["points"]) == 30
+    assert s.values.tolist() == [p["x"] for p in cli["points"]]
+    assert s.point_labels == [p["label"] for p in cli["points"]]
+    for r, p in zip(s.points, cli["points"]):
+        assert [f["count"] for f in r.to_dict()["faces"]] == [f["count"] for f in p["faces"]]
+        assert r.seed == cli["seed"] and r.tosses == 200
