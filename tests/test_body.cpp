@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <random>
@@ -233,6 +234,15 @@ TEST(BodyLabels, NearestNormalSharedLabelsAndNumberingOfTheRest) {
   EXPECT_EQ(box.face_labels, (std::vector<int>{2, 5, 3, 4, 9, 6}));
 }
 
+TEST(BodyLabels, RoundedBoxKeepsItsFaceMapByDirection) {
+  const Body b = body_of("shape = \"d6\"\nsize = 0.016\nrounding = 0.002\n[die.faces]\n\"+x\" = 9\n");
+  const Vec3 dirs[6] = {Vec3::UnitX(), -Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitY(), Vec3::UnitZ(), -Vec3::UnitZ()};
+  const int expected[6] = {9, 5, 3, 4, 1, 6};
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(b.face_labels[nearest_face(b.shape, dirs[k])], expected[k]) << k;
+  const Body box = body_of("size = [0.02, 0.03, 0.04]\nrounding = 0.001\n");
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(box.face_labels[nearest_face(box.shape, dirs[k])], (std::array<int, 6>{2, 5, 3, 4, 1, 6})[k]);
+}
+
 TEST(BodyLabels, TwoLabelsOnOneFaceIsAnError) {
   try {
     body_of("shape = \"d6\"\n[[die.labels]]\nnormal = [0, 0, 1]\nlabel = 1\n[[die.labels]]\nnormal = [0.1, 0, 1]\nlabel = 2\n");
@@ -378,6 +388,10 @@ TEST(BodyErrors, ObjThatDoesNotParseOrIsNotClosedNamesTheLine) {
     inverted += l + "\n";
   }
   expect_has(obj_error(inverted).allowed(), "inward");
+
+  // A closed but flat mesh: a square's two sides.
+  expect_has(obj_error("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\nf 2 1 4\nf 2 4 3\n").allowed(),
+             "no volume");
 }
 
 }  // namespace
