@@ -193,6 +193,28 @@ TEST(BodyShapes, HullMergesCoplanarTrianglesAndDropsPointsOnEdgesAndFaces) {
   EXPECT_EQ(s.normals[0], Vec3(0, 0, 1)) << "canonical order: top face first";
 }
 
+TEST(BodyShapes, HullOfDenseCoplanarGridsIsStillABox) {
+  // Many points on every face and edge: qhull's triangulation (Qt) has zero-area triangles here,
+  // which are oriented by qhull's own orientation, not by their (zero) cross product.
+  std::vector<Vec3> points;
+  for (int x = 0; x <= 6; ++x)
+    for (int y = 0; y <= 6; ++y)
+      for (int z = 0; z <= 6; ++z) points.push_back(Vec3(0.002 * x, 0.003 * y, 0.001 * z));
+  const ConvexShape s = convex_hull(points);
+  EXPECT_EQ(s.vertices.size(), 8u);
+  EXPECT_EQ(s.faces.size(), 6u);
+  expect_well_formed(s);
+  // Collinear points on a square's edges and a regular polygon's rim.
+  std::vector<Vec3> rim;
+  for (int k = 0; k < 24; ++k)
+    for (double z : {0.0, 0.01}) rim.emplace_back(0.01 * std::cos(2 * kPi * k / 24), 0.01 * std::sin(2 * kPi * k / 24), z);
+  for (int k = 0; k < 24; ++k) rim.emplace_back(0.004 * std::cos(2 * kPi * k / 24), 0.004 * std::sin(2 * kPi * k / 24), 0.01);
+  const ConvexShape p = convex_hull(rim);
+  EXPECT_EQ(p.vertices.size(), 48u);
+  EXPECT_EQ(p.faces.size(), 26u);
+  expect_well_formed(p);
+}
+
 TEST(BodyShapes, HullOrderDoesNotDependOnInputOrder) {
   const Body a = body_of("shape = \"d20\"\n");
   std::vector<Vec3> shuffled = a.shape.vertices;

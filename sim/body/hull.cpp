@@ -48,8 +48,9 @@ std::vector<HullTriangle> qhull_triangles(const std::vector<Vec3>& points) {
       }
       if (k != 3) continue;
       t.normal = Vec3(facet->normal[0], facet->normal[1], facet->normal[2]);
-      const Vec3 e = (points[t.v[1]] - points[t.v[0]]).cross(points[t.v[2]] - points[t.v[0]]);
-      if (e.dot(t.normal) < 0.0) std::swap(t.v[1], t.v[2]);
+      // qhull's own orientation (as its OFF output): the listed order is counter-clockwise from
+      // outside unless toporient. Combinatorial, so also right for Qt's zero-area triangles.
+      if (facet->toporient) std::swap(t.v[0], t.v[1]);
       out.push_back(t);
     }
   }
