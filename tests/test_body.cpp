@@ -215,6 +215,24 @@ TEST(BodyShapes, HullOfDenseCoplanarGridsIsStillABox) {
   expect_well_formed(p);
 }
 
+TEST(BodyShapes, CoplanarToleranceIsTheDocumentedOne) {
+  // A 20 mm cube (diagonal D = 34.6 mm, tolerance 1e-6 D = 34.6 nm) with the centre of its +x
+  // face pushed out by 10 nm (merged: still 6 faces) or by 100 nm (a low pyramid: 4 faces more).
+  auto hull_with_bump = [](double bump) {
+    std::vector<Vec3> p;
+    for (int c = 0; c < 8; ++c) p.push_back(0.01 * Vec3((c & 1) ? 1 : -1, (c & 2) ? 1 : -1, (c & 4) ? 1 : -1));
+    p.push_back(Vec3(0.01 + bump, 0.0, 0.0));
+    return convex_hull(p);
+  };
+  const ConvexShape merged = hull_with_bump(1e-8);
+  EXPECT_EQ(merged.faces.size(), 6u);
+  EXPECT_EQ(merged.vertices.size(), 8u);
+  const ConvexShape pyramid = hull_with_bump(1e-7);
+  EXPECT_EQ(pyramid.faces.size(), 9u);
+  EXPECT_EQ(pyramid.vertices.size(), 9u);
+  expect_well_formed(pyramid);
+}
+
 TEST(BodyShapes, HullOrderDoesNotDependOnInputOrder) {
   const Body a = body_of("shape = \"d20\"\n");
   std::vector<Vec3> shuffled = a.shape.vertices;
