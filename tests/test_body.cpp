@@ -457,7 +457,7 @@ TEST(BodyReadyScenes, EveryDiceSceneBuilds) {
                         {"d8.toml", 8, false, 0.0},         {"d10.toml", 10, false, 0.0},
                         {"d12.toml", 12, false, 0.0},       {"d20.toml", 20, false, 0.0},
                         {"loaded-d20.toml", 20, false, 0.0}, {"steel-cuboid.toml", 6, false, 0.0},
-                        {"prism3.toml", 5, true, 0.0}};
+                        {"prism3.toml", 5, true, 0.0},       {"hollow-d6.toml", 6, false, 0.0}};
   for (const Case& c : cases) {
     SCOPED_TRACE(c.file);
     const Body b = ready(c.file);
@@ -467,6 +467,20 @@ TEST(BodyReadyScenes, EveryDiceSceneBuilds) {
     expect_well_formed(b.shape);
     EXPECT_GT(b.mass.mass, 0.0);
   }
+}
+
+TEST(BodyReadyScenes, HollowD6MeshHasItsCavitysMassAndItsHullsFaces) {
+  const Body b = ready("hollow-d6.toml");
+  EXPECT_EQ(b.kind, "mesh");
+  EXPECT_FALSE(b.convex);
+  EXPECT_EQ(b.shape.vertices.size(), 8u) << "the cavity's corners are not on the hull";
+  EXPECT_EQ(b.shape.faces.size(), 6u);
+  // 16^3 - 6^3 = 3880 mm^3 of plastic; the cavity's centre is 3 mm above the cube's.
+  EXPECT_NEAR(b.mass.mass, 1180.0 * 3880e-9, 1e-15);
+  EXPECT_NEAR(b.mass.com.z(), -216.0 * 3.0 / 3880.0 * 1e-3, 1e-15);
+  EXPECT_LE(b.mass.com.head<2>().norm(), 1e-15);
+  for (std::size_t f = 0; f < 6; ++f) EXPECT_EQ(b.face_labels[f] + b.face_labels[nearest_face(b.shape, -b.shape.normals[f])], 7);
+  EXPECT_EQ(b.face_labels[nearest_face(b.shape, Vec3::UnitZ())], 1);
 }
 
 TEST(BodyReadyScenes, LoadedD20IsHeavyTowardsItsSlabFace) {
