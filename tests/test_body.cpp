@@ -233,6 +233,35 @@ TEST(BodyShapes, CoplanarToleranceIsTheDocumentedOne) {
   expect_well_formed(pyramid);
 }
 
+TEST(BodyShapes, HullOfNoisyAndRepeatedPointsIsWellFormed) {
+  // A cube grid jittered by about the coplanar tolerance, with every point twice: whatever merges,
+  // the result is a closed, outward, planar (within the tolerance) polytope.
+  std::mt19937_64 rng(7);
+  for (double noise : {1e-10, 3e-8, 1e-7}) {
+    std::normal_distribution<double> g(0.0, noise);
+    std::vector<Vec3> points;
+    for (int x = 0; x <= 4; ++x)
+      for (int y = 0; y <= 4; ++y)
+        for (int z = 0; z <= 4; ++z) {
+          const Vec3 p = 0.005 * Vec3(x, y, z) + Vec3(g(rng), g(rng), g(rng));
+          points.push_back(p);
+          points.push_back(p);
+        }
+    const ConvexShape s = convex_hull(points);
+    EXPECT_EQ(euler_characteristic(s), 2) << noise;
+    for (std::size_t f = 0; f < s.faces.size(); ++f) {
+      const Vec3& n = s.normals[f];
+      double hi = -1.0, lo = 1.0;
+      for (int v : s.faces[f]) {
+        hi = std::max(hi, n.dot(s.vertices[v]));
+        lo = std::min(lo, n.dot(s.vertices[v]));
+      }
+      EXPECT_LE(hi - lo, 2.0 * kCoplanarTolerance * 0.035) << "face " << f << " is planar within the tolerance";
+      for (const Vec3& p : points) EXPECT_LE(n.dot(p), hi + 2.0 * kCoplanarTolerance * 0.035);
+    }
+  }
+}
+
 TEST(BodyShapes, HullOrderDoesNotDependOnInputOrder) {
   const Body a = body_of("shape = \"d20\"\n");
   std::vector<Vec3> shuffled = a.shape.vertices;

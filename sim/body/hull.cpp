@@ -157,31 +157,42 @@ ConvexShape convex_hull(const std::vector<Vec3>& points) {
     shape.normals.push_back(area.norm() > 0.0 ? Vec3(area.normalized()) : tris[groups[g][0]].normal.normalized());
   }
 
-  // Corners that are straight (within tol of the line through their neighbours) on every face they
-  // are on are not corners: points on an edge.
+  // Corners that are straight (within tol of the line through their neighbours) on both faces they
+  // are on are not corners: points on an edge. (A point on three or more faces stays: removing it
+  // from faces whose neighbours differ would leave edges without a partner.)
   std::map<int, bool> straight;  // point -> straight on every face so far
+  std::map<int, int> face_count;
+  for (const auto& loop : loops)
+    for (int p : loop) ++face_count[p];
   for (const auto& loop : loops)
     for (std::size_t k = 0; k < loop.size(); ++k) {
       const Vec3& p = points[loop[(k + loop.size() - 1) % loop.size()]];
       const Vec3& v = points[loop[k]];
       const Vec3& q = points[loop[(k + 1) % loop.size()]];
       const Vec3 dir = (q - p).normalized();
-      const bool s = ((v - p) - (v - p).dot(dir) * dir).norm() <= tol;
+      const bool s = face_count[loop[k]] == 2 && ((v - p) - (v - p).dot(dir) * dir).norm() <= tol;
       const auto [it, fresh] = straight.emplace(loop[k], s);
       if (!fresh) it->second = it->second && s;
     }
+  // A face left with 2 corners was a sliver along an edge, narrower than the tolerance: it goes,
+  // and the faces on either side meet directly (its points were on those two faces only).
   std::map<int, int> index;  // point -> shape vertex
-  for (auto& loop : loops) {
+  std::vector<Vec3> normals;
+  for (std::size_t f = 0; f < loops.size(); ++f) {
     std::vector<int> kept;
-    for (int p : loop)
-      if (!straight[p]) {
-        const auto [it, fresh] = index.emplace(p, static_cast<int>(shape.vertices.size()));
-        if (fresh) shape.vertices.push_back(points[p]);
-        kept.push_back(it->second);
-      }
-    if (kept.size() < 3) throw HullError("the hull is degenerate (a face has fewer than 3 corners)");
+    for (int p : loops[f])
+      if (!straight[p]) kept.push_back(p);
+    if (kept.size() < 3) continue;
+    for (int& p : kept) {
+      const auto [it, fresh] = index.emplace(p, static_cast<int>(shape.vertices.size()));
+      if (fresh) shape.vertices.push_back(points[p]);
+      p = it->second;
+    }
     shape.faces.push_back(std::move(kept));
+    normals.push_back(shape.normals[f]);
   }
+  shape.normals = std::move(normals);
+  if (shape.faces.size() < 4) throw HullError("the hull is degenerate (fewer than 4 faces)");
   canonical_order(shape);
   return shape;
 }
