@@ -130,31 +130,52 @@ ConvexShape convex_hull(const std::vector<Vec3>& points) {
     }
   }
 
-  // Each group's outline: its triangles' edges whose reverse is not in the group, chained.
+  // Each group's outline: its triangles' edges whose reverse is not in the group, chained. A
+  // group whose outline is not one simple loop (noisy points can make a group touch itself at a
+  // corner) is not merged: its triangles stay faces of their own.
   ConvexShape shape;
   std::vector<std::vector<int>> loops;
-  for (int g = 0; g < static_cast<int>(groups.size()); ++g) {
+  auto outline = [&](const std::vector<int>& members, int g) -> std::vector<int> {
     std::map<int, int> next;
-    Vec3 area = Vec3::Zero();
-    for (int t : groups[g]) {
+    for (int t : members) {
       const auto& v = tris[t].v;
-      area += (points[v[1]] - points[v[0]]).cross(points[v[2]] - points[v[0]]);
       for (int k = 0; k < 3; ++k) {
         const auto it = edge_owner.find({v[(k + 1) % 3], v[k]});
-        if (it != edge_owner.end() && group[it->second] == g) continue;
-        if (!next.emplace(v[k], v[(k + 1) % 3]).second) throw HullError("the hull is degenerate (a face's outline is not one loop)");
+        if (it != edge_owner.end() && group[it->second] == g && members.size() > 1) continue;
+        if (!next.emplace(v[k], v[(k + 1) % 3]).second) return {};
       }
     }
     std::vector<int> loop = {next.begin()->first};
     while (loop.size() <= next.size()) {
       const auto it = next.find(loop.back());
-      if (it == next.end()) throw HullError("the hull is degenerate (a face's outline is not closed)");
+      if (it == next.end()) return {};
       if (it->second == loop.front()) break;
       loop.push_back(it->second);
     }
-    if (loop.size() != next.size() || loop.size() < 3) throw HullError("the hull is degenerate (a face's outline is not one loop)");
-    loops.push_back(std::move(loop));
-    shape.normals.push_back(area.norm() > 0.0 ? Vec3(area.normalized()) : tris[groups[g][0]].normal.normalized());
+    if (loop.size() != next.size() || loop.size() < 3) return {};
+    return loop;
+  };
+  auto area_normal = [&](const std::vector<int>& members) {
+    Vec3 area = Vec3::Zero();
+    for (int t : members) {
+      const auto& v = tris[t].v;
+      area += (points[v[1]] - points[v[0]]).cross(points[v[2]] - points[v[0]]);
+    }
+    return area.norm() > 0.0 ? Vec3(area.normalized()) : Vec3(tris[members[0]].normal.normalized());
+  };
+  for (int g = 0; g < static_cast<int>(groups.size()); ++g) {
+    std::vector<int> loop = outline(groups[g], g);
+    if (!loop.empty()) {
+      // The seed triangle's plane: qhull's supporting plane, which every corner of the group is
+      // within the tolerance of (an averaged normal could tilt away from it).
+      loops.push_back(std::move(loop));
+      shape.normals.push_back(groups[g].size() > 1 ? Vec3(tris[groups[g][0]].normal.normalized()) : area_normal(groups[g]));
+      continue;
+    }
+    for (int t : groups[g]) {
+      loops.push_back({tris[t].v[0], tris[t].v[1], tris[t].v[2]});
+      shape.normals.push_back(area_normal({t}));
+    }
   }
 
   // Corners that are straight (within tol of the line through their neighbours) on both faces they

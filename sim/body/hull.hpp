@@ -22,8 +22,8 @@ struct HullError : std::runtime_error {
 };
 
 // The hull in the canonical order of shape.hpp (canonical_order). Faces: planar within the
-// tolerance above, counter-clockwise from outside, outward normals (area-weighted mean of the
-// face's triangles' normals). Uses qhull (libqhull_r, option Qt).
+// tolerance above, counter-clockwise from outside, outward normals (qhull's supporting plane of
+// the face's first triangle; a face of one triangle: that triangle's own normal). Uses qhull (libqhull_r, option Qt).
 ConvexShape convex_hull(const std::vector<Vec3>& points);
 
 }  // namespace dicesim
