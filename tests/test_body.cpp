@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 #include <string>
@@ -192,6 +194,85 @@ TEST(BodyShapes, HullMergesCoplanarTrianglesAndDropsPointsOnEdgesAndFaces) {
   EXPECT_EQ(s.normals[0], Vec3(0, 0, 1)) << "canonical order: top face first";
 }
 
+TEST(BodyShapes, HullOfDenseCoplanarGridsIsStillABox) {
+  // Many points on every face and edge: qhull's triangulation (Qt) has zero-area triangles here,
+  // which are oriented by qhull's own orientation, not by their (zero) cross product.
+  std::vector<Vec3> points;
+  for (int x = 0; x <= 6; ++x)
+    for (int y = 0; y <= 6; ++y)
+      for (int z = 0; z <= 6; ++z) points.push_back(Vec3(0.002 * x, 0.003 * y, 0.001 * z));
+  const ConvexShape s = convex_hull(points);
+  EXPECT_EQ(s.vertices.size(), 8u);
+  EXPECT_EQ(s.faces.size(), 6u);
+  expect_well_formed(s);
+  // Collinear points on a square's edges and a regular polygon's rim.
+  std::vector<Vec3> rim;
+  for (int k = 0; k < 24; ++k)
+    for (double z : {0.0, 0.01}) rim.emplace_back(0.01 * std::cos(2 * kPi * k / 24), 0.01 * std::sin(2 * kPi * k / 24), z);
+  for (int k = 0; k < 24; ++k) rim.emplace_back(0.004 * std::cos(2 * kPi * k / 24), 0.004 * std::sin(2 * kPi * k / 24), 0.01);
+  const ConvexShape p = convex_hull(rim);
+  EXPECT_EQ(p.vertices.size(), 48u);
+  EXPECT_EQ(p.faces.size(), 26u);
+  expect_well_formed(p);
+}
+
+TEST(BodyShapes, CoplanarToleranceIsTheDocumentedOne) {
+  // A 20 mm cube (diagonal D = 34.6 mm, tolerance 1e-6 D = 34.6 nm) with the centre of its +x
+  // face pushed out by 10 nm (merged: still 6 faces) or by 100 nm (a low pyramid: 4 faces more).
+  auto hull_with_bump = [](double bump) {
+    std::vector<Vec3> p;
+    for (int c = 0; c < 8; ++c) p.push_back(0.01 * Vec3((c & 1) ? 1 : -1, (c & 2) ? 1 : -1, (c & 4) ? 1 : -1));
+    p.push_back(Vec3(0.01 + bump, 0.0, 0.0));
+    return convex_hull(p);
+  };
+  const ConvexShape merged = hull_with_bump(1e-8);
+  EXPECT_EQ(merged.faces.size(), 6u);
+  EXPECT_EQ(merged.vertices.size(), 8u);
+  const ConvexShape pyramid = hull_with_bump(1e-7);
+  EXPECT_EQ(pyramid.faces.size(), 9u);
+  EXPECT_EQ(pyramid.vertices.size(), 9u);
+  expect_well_formed(pyramid);
+}
+
+TEST(BodyShapes, HullOfNoisyAndRepeatedPointsIsWellFormed) {
+  // A cube grid jittered by about the coplanar tolerance, with every point twice: whatever merges,
+  // the result is a closed, outward, planar (within the tolerance) polytope.
+  for (int seed = 0; seed < 40; ++seed)
+  for (double noise : {1e-10, 1e-8, 3e-8, 1e-7}) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> g(0.0, noise);
+    std::vector<Vec3> points;
+    const int n = 2 + seed % 4;
+    for (int x = 0; x <= n; ++x)
+      for (int y = 0; y <= n; ++y)
+        for (int z = 0; z <= n; ++z) {
+          const Vec3 p = 0.02 / n * Vec3(x, y, z) + Vec3(g(rng), g(rng), g(rng));
+          points.push_back(p);
+          points.push_back(p);
+        }
+    const ConvexShape s = convex_hull(points);
+    EXPECT_EQ(euler_characteristic(s), 2) << noise;
+    // Closed and consistently oriented: every edge once in each direction.
+    std::map<std::pair<int, int>, int> edges;
+    for (const auto& f : s.faces)
+      for (std::size_t k = 0; k < f.size(); ++k) ++edges[{f[k], f[(k + 1) % f.size()]}];
+    for (const auto& [e, count] : edges) {
+      EXPECT_EQ(count, 1) << "seed " << seed << " noise " << noise;
+      EXPECT_EQ(edges.count({e.second, e.first}), 1u) << "seed " << seed << " noise " << noise;
+    }
+    for (std::size_t f = 0; f < s.faces.size(); ++f) {
+      const Vec3& n = s.normals[f];
+      double hi = -1.0, lo = 1.0;
+      for (int v : s.faces[f]) {
+        hi = std::max(hi, n.dot(s.vertices[v]));
+        lo = std::min(lo, n.dot(s.vertices[v]));
+      }
+      EXPECT_LE(hi - lo, 1.01 * kCoplanarTolerance * 0.0347) << "face " << f << " is planar within the tolerance";
+      for (const Vec3& p : points) EXPECT_LE(n.dot(p), hi + 2.0 * kCoplanarTolerance * 0.035);
+    }
+  }
+}
+
 TEST(BodyShapes, HullOrderDoesNotDependOnInputOrder) {
   const Body a = body_of("shape = \"d20\"\n");
   std::vector<Vec3> shuffled = a.shape.vertices;
@@ -231,6 +312,15 @@ TEST(BodyLabels, NearestNormalSharedLabelsAndNumberingOfTheRest) {
   // The box: [[die.labels]] on top of [die.faces].
   const Body box = body_of("[[die.labels]]\nnormal = [0, 0, 1]\nlabel = 9\n");
   EXPECT_EQ(box.face_labels, (std::vector<int>{2, 5, 3, 4, 9, 6}));
+}
+
+TEST(BodyLabels, RoundedBoxKeepsItsFaceMapByDirection) {
+  const Body b = body_of("shape = \"d6\"\nsize = 0.016\nrounding = 0.002\n[die.faces]\n\"+x\" = 9\n");
+  const Vec3 dirs[6] = {Vec3::UnitX(), -Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitY(), Vec3::UnitZ(), -Vec3::UnitZ()};
+  const int expected[6] = {9, 5, 3, 4, 1, 6};
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(b.face_labels[nearest_face(b.shape, dirs[k])], expected[k]) << k;
+  const Body box = body_of("size = [0.02, 0.03, 0.04]\nrounding = 0.001\n");
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(box.face_labels[nearest_face(box.shape, dirs[k])], (std::array<int, 6>{2, 5, 3, 4, 1, 6})[k]);
 }
 
 TEST(BodyLabels, TwoLabelsOnOneFaceIsAnError) {
@@ -378,6 +468,10 @@ TEST(BodyErrors, ObjThatDoesNotParseOrIsNotClosedNamesTheLine) {
     inverted += l + "\n";
   }
   expect_has(obj_error(inverted).allowed(), "inward");
+
+  // A closed but flat mesh: a square's two sides.
+  expect_has(obj_error("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\nf 2 1 4\nf 2 4 3\n").allowed(),
+             "no volume");
 }
 
 }  // namespace
@@ -403,7 +497,7 @@ TEST(BodyReadyScenes, EveryDiceSceneBuilds) {
                         {"d8.toml", 8, false, 0.0},         {"d10.toml", 10, false, 0.0},
                         {"d12.toml", 12, false, 0.0},       {"d20.toml", 20, false, 0.0},
                         {"loaded-d20.toml", 20, false, 0.0}, {"steel-cuboid.toml", 6, false, 0.0},
-                        {"prism3.toml", 5, true, 0.0}};
+                        {"prism3.toml", 5, true, 0.0},       {"hollow-d6.toml", 6, false, 0.0}};
   for (const Case& c : cases) {
     SCOPED_TRACE(c.file);
     const Body b = ready(c.file);
@@ -413,6 +507,20 @@ TEST(BodyReadyScenes, EveryDiceSceneBuilds) {
     expect_well_formed(b.shape);
     EXPECT_GT(b.mass.mass, 0.0);
   }
+}
+
+TEST(BodyReadyScenes, HollowD6MeshHasItsCavitysMassAndItsHullsFaces) {
+  const Body b = ready("hollow-d6.toml");
+  EXPECT_EQ(b.kind, "mesh");
+  EXPECT_FALSE(b.convex);
+  EXPECT_EQ(b.shape.vertices.size(), 8u) << "the cavity's corners are not on the hull";
+  EXPECT_EQ(b.shape.faces.size(), 6u);
+  // 16^3 - 6^3 = 3880 mm^3 of plastic; the cavity's centre is 3 mm above the cube's.
+  EXPECT_NEAR(b.mass.mass, 1180.0 * 3880e-9, 1e-15);
+  EXPECT_NEAR(b.mass.com.z(), -216.0 * 3.0 / 3880.0 * 1e-3, 1e-15);
+  EXPECT_LE(b.mass.com.head<2>().norm(), 1e-15);
+  for (std::size_t f = 0; f < 6; ++f) EXPECT_EQ(b.face_labels[f] + b.face_labels[nearest_face(b.shape, -b.shape.normals[f])], 7);
+  EXPECT_EQ(b.face_labels[nearest_face(b.shape, Vec3::UnitZ())], 1);
 }
 
 TEST(BodyReadyScenes, LoadedD20IsHeavyTowardsItsSlabFace) {

@@ -873,3 +873,30 @@ TEST(LoadedMassProperties, RegionOnAPresetIsExact) {
 
 }  // namespace
 }  // namespace dicesim
+
+namespace dicesim {
+namespace {
+
+TEST(RoundedMassProperties, SlabCutOfARoundedCubeIsExact) {
+  // A rounded d6 (core edge c = s - 2r, h = c/2) whose z <= 0 half is lead. The cut is
+  // perpendicular to the four vertical edges (split exactly along their length) and misses every
+  // other rounded piece. By symmetry each half has volume V/2; the first moment of the upper half:
+  //   core c^2 h^2/2; top slab c^2 ((h+r)^2 - h^2)/2; 4 side slabs c r h^2/2;
+  //   4 top edges c (h pi r^2/4 + r^3/3); 4 vertical half-edges pi r^2/4 h^2/2;
+  //   4 top corners h pi r^3/6 + pi r^4/16.
+  const double s = 0.016, r = 0.002, c = s - 2.0 * r, h = c / 2.0, lead = 11340.0;
+  const Body b = shaped("shape = \"d6\"\nsize = 0.016\nrounding = 0.002\n[[die.regions]]\nmaterial = \"lead\"\n"
+                        "cuts = [{normal = [0, 0, 1]}]\n",
+                        "[materials.lead]\ndensity = 11340.0\n");
+  const double volume = c * c * c + 6.0 * c * c * r + 3.0 * kPi * c * r * r + 4.0 / 3.0 * kPi * r * r * r;
+  const double zup = c * c * h * h / 2.0 + c * c * ((h + r) * (h + r) - h * h) / 2.0 + 4.0 * c * r * h * h / 2.0 +
+                     4.0 * c * (h * kPi * r * r / 4.0 + r * r * r / 3.0) + 4.0 * kPi * r * r / 4.0 * h * h / 2.0 +
+                     4.0 * (h * kPi * r * r * r / 6.0 + kPi * std::pow(r, 4) / 16.0);
+  const double mass = (kDensity + lead) / 2.0 * volume;
+  EXPECT_NEAR(b.mass.mass, mass, kRel * mass);
+  EXPECT_NEAR(b.mass.com.z(), (kDensity - lead) * zup / mass, 1e-12 * h);
+  EXPECT_LE(b.mass.com.head<2>().norm(), 1e-15);
+}
+
+}  // namespace
+}  // namespace dicesim

@@ -654,6 +654,10 @@ TEST(SceneShapes, BadShapeKeysNameKeyValueAndRange) {
   const SceneError label = shape_error("[[die.labels]]\nnormal = [0, 0, 0]\nlabel = 1\n");
   EXPECT_EQ(label.key(), "die.labels[0].normal");
 
+  const SceneError mesh_rounding = shape_error("shape = \"mesh\"\nmesh = \"x.obj\"\nrounding = 0.001\n");
+  EXPECT_EQ(mesh_rounding.key(), "die.rounding");
+  expect_contains(mesh_rounding.allowed(), "does not apply to shape = \"mesh\"");
+
   const SceneError faces = shape_error("shape = \"d8\"\n[die.faces]\n\"+z\" = 1\n");
   EXPECT_EQ(faces.key(), "die.faces");
   expect_contains(faces.allowed(), "[[die.labels]]");

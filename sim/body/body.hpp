@@ -12,6 +12,9 @@
 
 namespace dicesim {
 
+// Face order: box (and a sharp d6) +x, -x, +y, -y, +z, -z; every other shape, and a rounded box,
+// the canonical order of shape.hpp (canonical_order). A rounded die's shape is its core (its
+// corners are the centres of the corner balls) with shape.rounding = r.
 struct Body {
   std::string kind = "box";                 // the scene's die.shape
   ConvexShape shape;                        // what can touch the floor (the hull, for a mesh)

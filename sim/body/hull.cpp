@@ -48,8 +48,9 @@ std::vector<HullTriangle> qhull_triangles(const std::vector<Vec3>& points) {
       }
       if (k != 3) continue;
       t.normal = Vec3(facet->normal[0], facet->normal[1], facet->normal[2]);
-      const Vec3 e = (points[t.v[1]] - points[t.v[0]]).cross(points[t.v[2]] - points[t.v[0]]);
-      if (e.dot(t.normal) < 0.0) std::swap(t.v[1], t.v[2]);
+      // qhull's own orientation (as its OFF output): the listed order is counter-clockwise from
+      // outside unless toporient. Combinatorial, so also right for Qt's zero-area triangles.
+      if (facet->toporient) std::swap(t.v[0], t.v[1]);
       out.push_back(t);
     }
   }
@@ -129,58 +130,90 @@ ConvexShape convex_hull(const std::vector<Vec3>& points) {
     }
   }
 
-  // Each group's outline: its triangles' edges whose reverse is not in the group, chained.
+  // Each group's outline: its triangles' edges whose reverse is not in the group, chained. A
+  // group whose outline is not one simple loop (noisy points can make a group touch itself at a
+  // corner) is not merged: its triangles stay faces of their own.
   ConvexShape shape;
   std::vector<std::vector<int>> loops;
-  for (int g = 0; g < static_cast<int>(groups.size()); ++g) {
+  auto outline = [&](const std::vector<int>& members, int g) -> std::vector<int> {
     std::map<int, int> next;
-    Vec3 area = Vec3::Zero();
-    for (int t : groups[g]) {
+    for (int t : members) {
       const auto& v = tris[t].v;
-      area += (points[v[1]] - points[v[0]]).cross(points[v[2]] - points[v[0]]);
       for (int k = 0; k < 3; ++k) {
         const auto it = edge_owner.find({v[(k + 1) % 3], v[k]});
-        if (it != edge_owner.end() && group[it->second] == g) continue;
-        if (!next.emplace(v[k], v[(k + 1) % 3]).second) throw HullError("the hull is degenerate (a face's outline is not one loop)");
+        if (it != edge_owner.end() && group[it->second] == g && members.size() > 1) continue;
+        if (!next.emplace(v[k], v[(k + 1) % 3]).second) return {};
       }
     }
     std::vector<int> loop = {next.begin()->first};
     while (loop.size() <= next.size()) {
       const auto it = next.find(loop.back());
-      if (it == next.end()) throw HullError("the hull is degenerate (a face's outline is not closed)");
+      if (it == next.end()) return {};
       if (it->second == loop.front()) break;
       loop.push_back(it->second);
     }
-    if (loop.size() != next.size() || loop.size() < 3) throw HullError("the hull is degenerate (a face's outline is not one loop)");
-    loops.push_back(std::move(loop));
-    shape.normals.push_back(area.norm() > 0.0 ? Vec3(area.normalized()) : tris[groups[g][0]].normal.normalized());
+    if (loop.size() != next.size() || loop.size() < 3) return {};
+    return loop;
+  };
+  auto area_normal = [&](const std::vector<int>& members) {
+    Vec3 area = Vec3::Zero();
+    for (int t : members) {
+      const auto& v = tris[t].v;
+      area += (points[v[1]] - points[v[0]]).cross(points[v[2]] - points[v[0]]);
+    }
+    return area.norm() > 0.0 ? Vec3(area.normalized()) : Vec3(tris[members[0]].normal.normalized());
+  };
+  for (int g = 0; g < static_cast<int>(groups.size()); ++g) {
+    std::vector<int> loop = outline(groups[g], g);
+    if (!loop.empty()) {
+      // The seed triangle's plane: qhull's supporting plane, which every corner of the group is
+      // within the tolerance of (an averaged normal could tilt away from it).
+      loops.push_back(std::move(loop));
+      shape.normals.push_back(groups[g].size() > 1 ? Vec3(tris[groups[g][0]].normal.normalized()) : area_normal(groups[g]));
+      continue;
+    }
+    for (int t : groups[g]) {
+      loops.push_back({tris[t].v[0], tris[t].v[1], tris[t].v[2]});
+      shape.normals.push_back(area_normal({t}));
+    }
   }
 
-  // Corners that are straight (within tol of the line through their neighbours) on every face they
-  // are on are not corners: points on an edge.
+  // Corners that are straight (within tol of the line through their neighbours) on both faces they
+  // are on are not corners: points on an edge. (A point on three or more faces stays: removing it
+  // from faces whose neighbours differ would leave edges without a partner.)
   std::map<int, bool> straight;  // point -> straight on every face so far
+  std::map<int, int> face_count;
+  for (const auto& loop : loops)
+    for (int p : loop) ++face_count[p];
   for (const auto& loop : loops)
     for (std::size_t k = 0; k < loop.size(); ++k) {
       const Vec3& p = points[loop[(k + loop.size() - 1) % loop.size()]];
       const Vec3& v = points[loop[k]];
       const Vec3& q = points[loop[(k + 1) % loop.size()]];
       const Vec3 dir = (q - p).normalized();
-      const bool s = ((v - p) - (v - p).dot(dir) * dir).norm() <= tol;
+      const bool s = face_count[loop[k]] == 2 && ((v - p) - (v - p).dot(dir) * dir).norm() <= tol;
       const auto [it, fresh] = straight.emplace(loop[k], s);
       if (!fresh) it->second = it->second && s;
     }
+  // A face left with 2 corners was a sliver along an edge, narrower than the tolerance: it goes,
+  // and the faces on either side meet directly (its points were on those two faces only).
   std::map<int, int> index;  // point -> shape vertex
-  for (auto& loop : loops) {
+  std::vector<Vec3> normals;
+  for (std::size_t f = 0; f < loops.size(); ++f) {
     std::vector<int> kept;
-    for (int p : loop)
-      if (!straight[p]) {
-        const auto [it, fresh] = index.emplace(p, static_cast<int>(shape.vertices.size()));
-        if (fresh) shape.vertices.push_back(points[p]);
-        kept.push_back(it->second);
-      }
-    if (kept.size() < 3) throw HullError("the hull is degenerate (a face has fewer than 3 corners)");
+    for (int p : loops[f])
+      if (!straight[p]) kept.push_back(p);
+    if (kept.size() < 3) continue;
+    for (int& p : kept) {
+      const auto [it, fresh] = index.emplace(p, static_cast<int>(shape.vertices.size()));
+      if (fresh) shape.vertices.push_back(points[p]);
+      p = it->second;
+    }
     shape.faces.push_back(std::move(kept));
+    normals.push_back(shape.normals[f]);
   }
+  shape.normals = std::move(normals);
+  if (shape.faces.size() < 4) throw HullError("the hull is degenerate (fewer than 4 faces)");
   canonical_order(shape);
   return shape;
 }

@@ -50,7 +50,13 @@ std::vector<int> face_labels(const ConvexShape& s, const DieDef& die, const std:
   switch (die.shape) {
     case ShapeKind::Box:
     case ShapeKind::D6:
-      labels.assign(die.face_labels.begin(), die.face_labels.end());
+      // By direction: a rounded box's core is listed in the canonical order, not +x, -x, ...
+      for (int f = 0; f < n; ++f) {
+        const Vec3& m = s.normals[f];
+        int axis = 0;
+        m.cwiseAbs().maxCoeff(&axis);
+        labels[f] = die.face_labels[2 * axis + (m[axis] > 0.0 ? 0 : 1)];
+      }
       break;
     case ShapeKind::D8:
     case ShapeKind::D12:

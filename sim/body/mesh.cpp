@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <utility>
@@ -109,7 +110,16 @@ void check_closed(const ObjMesh& mesh, const std::string& file) {
                            " has no face on its other side: the mesh must be closed (watertight)");
   // Closed and consistent: the signed volume says whether the faces point out.
   double volume = 0.0;
-  for (const auto& t : mesh_triangles(mesh, 1.0)) volume += t[0].dot(t[1].cross(t[2])) / 6.0;
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const auto& t : mesh_triangles(mesh, 1.0)) {
+    volume += t[0].dot(t[1].cross(t[2])) / 6.0;
+    for (const Vec3& p : t) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  if (std::abs(volume) <= 1e-12 * std::pow((hi - lo).norm(), 3))
+    throw SceneError(file, "", "", "the faces enclose no volume (a flat mesh): a die must be a solid");
   if (!(volume > 0.0))
     throw SceneError(file, "", "", "the faces enclose a negative volume: they are oriented inward; OBJ faces must be "
                                    "counter-clockwise seen from outside (reverse every face)");

@@ -109,7 +109,7 @@ VolumeMoments corner_sector_moments(const Vec3& p, double sum_face_angles, const
   return m;
 }
 
-RoundedSolid::RoundedSolid(const ConvexShape& core, double r) {
+RoundedSolid::RoundedSolid(const ConvexShape& core, double r) : r_(r) {
   core_ = shape_triangles(core);
   double area = 0.0, edge_term = 0.0;
   for (std::size_t f = 0; f < core.faces.size(); ++f) {
@@ -137,19 +137,15 @@ RoundedSolid::RoundedSolid(const ConvexShape& core, double r) {
       const Vec3& b = core.vertices[next];
       const Vec3& n1 = core.normals[f];
       const Vec3& n2 = core.normals[other->second];
-      const VolumeMoments w = edge_wedge_moments(a, b, n1, n2, r);
-      edge_term += w.volume;
-      curved_.push_back(w);
-      curved_centroid_.push_back(w.volume > 0.0 ? Vec3(w.first / w.volume) : Vec3(0.5 * (a + b)));
+      edge_term += edge_wedge_moments(a, b, n1, n2, r).volume;
+      wedges_.push_back({a, b, n1, n2});
       const Vec3 e = (b - a).normalized();
       corner_edges[v].push_back({e, n1, n2});
       corner_edges[next].push_back({-e, n1, n2});
     }
   }
   for (std::size_t v = 0; v < core.vertices.size(); ++v) {
-    const VolumeMoments c = corner_sector_moments(core.vertices[v], angle_sum[v], corner_edges[v], r);
-    curved_.push_back(c);
-    curved_centroid_.push_back(c.volume > 0.0 ? Vec3(c.first / c.volume) : core.vertices[v]);
+    corners_.push_back(corner_sector_moments(core.vertices[v], angle_sum[v], corner_edges[v], r));
   }
   double core_volume = surface_moments(core_).volume;
   steiner_volume_ = core_volume + area * r + edge_term + 4.0 / 3.0 * kPi * r * r * r;
@@ -158,11 +154,34 @@ RoundedSolid::RoundedSolid(const ConvexShape& core, double r) {
 VolumeMoments RoundedSolid::moments(const std::vector<HalfSpace>& cuts) const {
   VolumeMoments m = clipped_surface_moments(core_, cuts);
   for (const Triangles& s : slabs_) add_moments(m, clipped_surface_moments(s, cuts));
-  for (std::size_t i = 0; i < curved_.size(); ++i) {
-    bool inside = true;
-    for (const HalfSpace& c : cuts) inside = inside && c.normal.dot(curved_centroid_[i]) <= c.offset;
-    if (inside) add_moments(m, curved_[i]);
+  auto keeps = [&](const VolumeMoments& piece, bool skip_parallel_to_edge, const Vec3& edge) {
+    if (!(piece.volume > 0.0)) return false;
+    const Vec3 centroid = piece.first / piece.volume;
+    for (const HalfSpace& c : cuts) {
+      if (skip_parallel_to_edge && std::abs(c.normal.normalized().dot(edge)) >= 1.0 - 1e-12) continue;
+      if (c.normal.dot(centroid) > c.offset) return false;
+    }
+    return true;
+  };
+  for (const Wedge& w : wedges_) {
+    const double length = (w.b - w.a).norm();
+    const Vec3 e = (w.b - w.a) / length;
+    double s0 = 0.0, s1 = length;
+    for (const HalfSpace& c : cuts) {
+      const double along = c.normal.dot(e);
+      if (std::abs(along) < (1.0 - 1e-12) * c.normal.norm()) continue;
+      const double bound = (c.offset - c.normal.dot(w.a)) / along;  // c.normal.(a + s e) <= offset
+      if (along > 0.0)
+        s1 = std::min(s1, bound);
+      else
+        s0 = std::max(s0, bound);
+    }
+    if (!(s1 > s0)) continue;
+    const VolumeMoments piece = edge_wedge_moments(w.a + s0 * e, w.a + s1 * e, w.n1, w.n2, r_);
+    if (keeps(piece, true, e)) add_moments(m, piece);
   }
+  for (const VolumeMoments& c : corners_)
+    if (keeps(c, false, Vec3::Zero())) add_moments(m, c);
   return m;
 }
 

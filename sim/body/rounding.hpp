@@ -26,10 +26,12 @@ class RoundedSolid {
   RoundedSolid(const ConvexShape& core, double r);
 
   // Volume moments of the rounded solid intersected with `cuts`. Exact for the core and the face
-  // slabs (polytopes, clipped); each edge wedge and corner sector (the curved parts) is counted
-  // whole when its centroid satisfies every cut and left out otherwise, so with cuts the result is
-  // exact unless a cut crosses a rounded edge or corner, and then off by at most the volume of
-  // the curved pieces it crosses. Without cuts it is exact.
+  // slabs (polytopes, clipped). An edge wedge is first cut exactly along its length by the cuts
+  // whose plane is perpendicular to the edge (a slab parallel to a box's face); what is left of it,
+  // and each corner sector, is counted whole when its centroid satisfies every other cut and left
+  // out otherwise. So the result is exact unless a cut crosses a rounded edge obliquely or a
+  // rounded corner, and then off by at most the volume of the curved pieces it crosses. Without
+  // cuts it is exact.
   VolumeMoments moments(const std::vector<HalfSpace>& cuts) const;
 
   // Steiner's formula: V + S r + (sum over edges of L theta / 2) r^2 + 4/3 pi r^3 (theta: the
@@ -37,10 +39,14 @@ class RoundedSolid {
   double steiner_volume() const { return steiner_volume_; }
 
  private:
+  struct Wedge {
+    Vec3 a, b, n1, n2;
+  };
+  double r_ = 0.0;
   Triangles core_;
   std::vector<Triangles> slabs_;
-  std::vector<VolumeMoments> curved_;
-  std::vector<Vec3> curved_centroid_;
+  std::vector<Wedge> wedges_;
+  std::vector<VolumeMoments> corners_;
   double steiner_volume_ = 0.0;
 };
 

@@ -315,7 +315,7 @@ std::string material_ref(Reader& r, const std::map<std::string, MaterialDef>& ma
 
 constexpr Range kScale{.lo = 0, .hi = 1e6, .lo_open = true};
 constexpr Range kRounding{.lo = 0, .hi = 100, .hi_open = true, .unit = "m"};
-constexpr Range kCoordinate{.lo = -100, .hi = 100, .unit = "m"};
+constexpr Range kCoordinate{.lo = -1e6, .hi = 1e6};  // times die.scale: metres
 constexpr Names<bool, 2> kReadSides{{{"up", false}, {"down", true}}};  // value: read_down
 
 constexpr bool is_preset(ShapeKind k) {
