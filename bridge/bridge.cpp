@@ -11,6 +11,7 @@
 
 #include "bridge/dds_writers.hpp"
 #include "bridge/translate.hpp"
+#include "messages/auth.hpp"
 #include "messages/wire.hpp"
 
 namespace dicesim::bridge {
@@ -37,9 +38,16 @@ struct Inbox {
   BridgeStats* stats;
   std::set<std::int64_t>* seen;
   std::chrono::steady_clock::time_point t0;
+  wire::Sealer sealer;
 
-  void handle(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+  void handle(const lcm::ReceiveBuffer* rb_in, const std::string& channel) {
     const double now = seconds_since(t0);
+    const auto len = sealer.open(channel, rb_in->data, rb_in->data_size);
+    if (!len) return void(++stats->unauthenticated);
+    struct {
+      const void* data;
+      std::size_t data_size;
+    } payload{rb_in->data, *len}, *rb = &payload;
     if (channel == wire::kProbabilities) {
       const auto m = wire::decode<dicesim_lcm::probabilities>(rb->data, rb->data_size);
       if (!m) return void(++stats->malformed);
@@ -82,7 +90,7 @@ BridgeStats run_bridge(const BridgeDef& def) {
   RunTable runs(def.runs);
   std::set<std::int64_t> seen;
   const auto t0 = std::chrono::steady_clock::now();
-  Inbox inbox{&dds, &runs, &stats, &seen, t0};
+  Inbox inbox{&dds, &runs, &stats, &seen, t0, wire::Sealer(def.key)};
   for (const char* ch : {wire::kProbabilities, wire::kRunStart, wire::kWorkerStatus}) {
     lcm::Subscription* sub = bus.subscribe(ch, &Inbox::handle, &inbox);
     sub->setQueueCapacity(256);  // answers come at 4 Hz, heartbeats at 5 Hz per worker
