@@ -231,6 +231,51 @@ case "$scenario" in
     code=0; "$bin" replay "$work/run.lcmlog" --key-file "$work/other.key" --json > /dev/null 2> "$work/otherkey.err" || code=$?
     [ "$code" -eq 2 ] || fail "replay with another key: exit $code"
     ;;
+  agg_restart)
+    # The aggregator itself dies (kill -9) mid-run and is resumed from its checkpoint: the same run
+    # id, the same two workers (never restarted), counts identical to toss; a recorder across the
+    # restart gives a log that replays to the same counts and says how many tosses were computed twice.
+    n=1000000
+    reference
+    ckpt=$work/run.ckpt
+    "$bin" record -o "$work/run.lcmlog" --until-done --timeout 150 2> "$work/rec.err" & rec=$!; pids+=($rec)
+    for _ in $(seq 100); do grep -q "dicesim record: recording" "$work/rec.err" && break; sleep 0.1; done
+    worker; worker
+    t0=$(date +%s%N)
+    "$bin" aggregate "$scene" --tosses "$n" --seed "$seed" --json --timeout 150 --checkpoint "$ckpt" \
+      > "$work/first.json" 2> "$work/agg1.err" & agg1=$!; pids+=($agg1)
+    # The first checkpoint (written at once) holds no toss; kill after one that does.
+    held() { jq '[.received[] | .[1] - .[0]] | add // 0' "$ckpt" 2> /dev/null || echo 0; }
+    for _ in $(seq 300); do [ -s "$ckpt" ] && [ "$(held)" -gt 0 ] && break; sleep 0.02; done
+    [ "$(held)" -gt 0 ] || fail "no checkpoint holding tosses was written"
+    kill -9 "$agg1"; wait "$agg1" 2> /dev/null || true
+    tk=$(date +%s%N)
+    echo "killed the aggregator; its last checkpoint holds $(held) of $n tosses"
+    "$bin" aggregate --resume "$ckpt" --json --timeout 150 > "$work/out.json" 2> "$work/agg.err" || fail "aggregate --resume exited $?"
+    t1=$(date +%s%N)
+    same_as_reference "$work/out.json"
+    [ ! -s "$work/first.json" ] || fail "the killed aggregator printed a result"
+    grep -h "resumed run\|checkpoint '" "$work/agg.err" || fail "no report of what the resume found"
+    grep -q "checkpoint '$ckpt'" "$work/agg.err" || fail "no checkpoint cost line"
+    for k in 1 2; do
+      wait "${wpid[$k]}" || fail "worker $k exited $?"
+      [ "$(grep -c "ended:" "$work/worker$k.err")" = 1 ] && grep -qE "ended: finished \([1-9][0-9]* tosses" "$work/worker$k.err" ||
+        fail "worker $k did not serve the run through the restart"
+    done
+    wait "$rec" || fail "dicesim record exited $?"
+    "$bin" replay "$work/run.lcmlog" --json > "$work/replay.json" 2> "$work/replay.err" || fail "replay exited $?"
+    same_as_reference "$work/replay.json"
+    twice=$(grep -oE '\(([0-9]+) more than once' "$work/replay.err" | grep -oE '[0-9]+')
+    # Bound: one checkpoint interval (1 s) and the restart's own gap (kill to the resumed
+    # aggregator's first log line) of the run's throughput, plus the leases the workers had queued
+    # (2 each, at most 8192 tosses).
+    rate=$((n * 1000000000 / (t1 - t0)))
+    up=$(date -d "$(grep -m1 -oE '^\[[0-9-]+ [0-9:.]+\]' "$work/agg.err" | tr -d '[]')" +%s%N)
+    gap_ms=$(((up - tk) / 1000000))
+    bound=$((rate + rate * gap_ms / 1000 + 2 * 2 * 8192))
+    echo "aggregator killed and resumed: $twice tosses computed twice (bound $bound: 1 s + restart $gap_ms ms at $rate tosses/s + queued leases)"
+    [ -n "$twice" ] && [ "$twice" -le "$bound" ] || fail "tosses computed twice: '$twice', more than $bound"
+    ;;
   *) echo "unknown scenario $scenario" >&2; exit 2 ;;
 esac
 [ -f "$work/agg.err" ] && grep -h "batches" "$work/agg.err"
