@@ -65,13 +65,18 @@ for k in $(seq "$nworkers"); do start_worker "$k"; done
 t0=$(date +%s%N)
 start_aggregator 1 "$scene" --tosses "$n" --seed "$seed" --checkpoint "$work/soak.ckpt"
 
-# Memory of every process, every second: /proc/PID/status VmRSS.
+# Memory of every process, every second: VmRSS from /proc/PID/status, read without forking (the
+# machine may be busy; a fork per sample would make the sampler late).
 (
   echo "t_s,role,pid,rss_kb"
+  start=${EPOCHREALTIME%.*}
   while :; do
-    t=$(( ($(date +%s%N) - t0) / 1000000000 ))
+    t=$(( ${EPOCHREALTIME%.*} - start ))
     while read -r role p; do
-      rss=$(awk '/^VmRSS:/ { print $2 }' "/proc/$p/status" 2> /dev/null) || continue
+      rss=""
+      while read -r k v _; do
+        if [ "$k" = "VmRSS:" ]; then rss=$v; break; fi
+      done < "/proc/$p/status" 2> /dev/null || true
       [ -n "$rss" ] && echo "$t,$role,$p,$rss"
     done < "$work/pids"
     sleep 1
@@ -116,9 +121,8 @@ awk -F, 'NR > 1 { if ($4 > max[$2]) max[$2] = $4; n[$2]++ }
 awk -F, '$2 == "aggregator" { t[++k] = $1; r[k] = $4 }
          END { if (k) printf "soak: aggregator RSS at t=%ds %.1f MB, t=%ds %.1f MB, t=%ds %.1f MB\n",
                  t[1], r[1] / 1024, t[int((k + 1) / 2)], r[int((k + 1) / 2)] / 1024, t[k], r[k] / 1024 }' "$out_csv"
-awk -F, '$2 == "worker" { by[$1] = (by[$1] > $4 ? by[$1] : $4) }
-         END { for (s in by) { if (!f || s < f) f = s; if (s > l) l = s }
-               if (f != "") printf "soak: largest worker RSS at t=%ds %.1f MB, at t=%ds %.1f MB\n", f, by[f] / 1024, l, by[l] / 1024 }' "$out_csv"
+awk -F, '$2 == "worker" { t = $1 + 0; if (!(t in by) || $4 > by[t]) by[t] = $4; if (f == "" || t < f) f = t; if (t > l) l = t }
+         END { if (f != "") printf "soak: largest worker RSS at t=%ds %.1f MB, at t=%ds %.1f MB\n", f, by[f] / 1024, l, by[l] / 1024 }' "$out_csv"
 echo "soak: memory samples in $out_csv"
 
 echo "soak: reference: dicesim toss --threads 2 (about $((n / 900000)) s)"
