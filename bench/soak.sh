@@ -76,7 +76,7 @@ start_aggregator 1 "$scene" --tosses "$n" --seed "$seed" --checkpoint "$work/soa
       rss=""
       while read -r k v _; do
         if [ "$k" = "VmRSS:" ]; then rss=$v; break; fi
-      done < "/proc/$p/status" 2> /dev/null || true
+      done 2> /dev/null < "/proc/$p/status" || true
       [ -n "$rss" ] && echo "$t,$role,$p,$rss"
     done < "$work/pids"
     sleep 1
