@@ -1,6 +1,9 @@
 // dicesim aggregate: start a distributed run over LCM, collect it, print it as `toss` does.
 // Also the aggregating half of `dicesim run` (aggregate_and_report).
+#include <unistd.h>
+
 #include <algorithm>
+#include <filesystem>
 #include <optional>
 #include <csignal>
 #include <cstdio>
@@ -120,6 +123,14 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   opt.cancel = cancel;
   opt.resume = resume ? &*resume : nullptr;
   opt.checkpoint_path = a.checkpoint.empty() ? a.resume : a.checkpoint;
+  if (!opt.checkpoint_path.empty()) {
+    // A checkpoint that cannot be written would only be noticed after a crash: bad input now.
+    std::string dir = std::filesystem::path(opt.checkpoint_path).parent_path().string();
+    if (dir.empty()) dir = ".";
+    if (std::filesystem::is_directory(opt.checkpoint_path) || ::access(dir.c_str(), W_OK | X_OK) != 0)
+      throw CLI::ValidationError("--checkpoint", "cannot write the checkpoint '" + opt.checkpoint_path +
+                                                     "' (its directory '" + dir + "' must exist and be writable)");
+  }
   if (!cfg.key.empty()) spdlog::info("authenticated run: every message is sealed and checked with HMAC-SHA-256 ({})", a.key_file);
   opt.on_start = [&](const agg::Aggregator& agg) {
     const agg::ResumeInfo& r = agg.resume_info();

@@ -101,6 +101,8 @@ TEST(LcmCli, BadKeyFilesAndCheckpointsAreBadInput) {
       "aggregate --resume " + short_key,             // not a checkpoint
       "aggregate",                                    // neither SCENE nor --resume
       "aggregate scenes/paper/die1.toml --resume " + short_key,  // both
+      "aggregate scenes/paper/die1.toml --checkpoint " + dir + "/no/such/dir/run.ckpt",
+      "aggregate scenes/paper/die1.toml --checkpoint " + dir,   // a directory
   };
   for (const std::string& c : cases) {
     const FullRun r = dicesim_full(c);
