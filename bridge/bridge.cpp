@@ -40,28 +40,27 @@ struct Inbox {
   std::chrono::steady_clock::time_point t0;
   wire::Sealer sealer;
 
-  void handle(const lcm::ReceiveBuffer* rb_in, const std::string& channel) {
+  void handle(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     const double now = seconds_since(t0);
-    const auto len = sealer.open(channel, rb_in->data, rb_in->data_size);
-    if (!len) return void(++stats->unauthenticated);
-    struct {
-      const void* data;
-      std::size_t data_size;
-    } payload{rb_in->data, *len}, *rb = &payload;
+    // With a key, only authentic messages go on (to DDS, or into the run table): the payload.
+    const auto opened = sealer.open(channel, rb->data, rb->data_size);
+    if (!opened) return void(++stats->unauthenticated);
+    const void* data = rb->data;
+    const std::size_t len = *opened;
     if (channel == wire::kProbabilities) {
-      const auto m = wire::decode<dicesim_lcm::probabilities>(rb->data, rb->data_size);
+      const auto m = wire::decode<dicesim_lcm::probabilities>(data, len);
       if (!m) return void(++stats->malformed);
       dds->write(to_dds(*m));  // first: this is the latency that matters
       ++stats->answers;
       note_run(m->run_id);
       runs->on_probabilities(*m, now);
     } else if (channel == wire::kRunStart) {
-      const auto m = wire::decode<dicesim_lcm::run_start>(rb->data, rb->data_size);
+      const auto m = wire::decode<dicesim_lcm::run_start>(data, len);
       if (!m) return void(++stats->malformed);
       note_run(m->run_id);
       runs->on_run_start(*m, now);
     } else if (channel == wire::kWorkerStatus) {
-      const auto m = wire::decode<dicesim_lcm::worker_status>(rb->data, rb->data_size);
+      const auto m = wire::decode<dicesim_lcm::worker_status>(data, len);
       if (!m) return void(++stats->malformed);
       runs->on_worker_status(*m, now);
     }
