@@ -35,6 +35,8 @@ std::vector<std::uint8_t> from_hex(const std::string& s) {
   return b;
 }
 
+// Every field of RunCounts: a field added there (e.g. counted corrections, or N outcomes instead
+// of 6) must be added here and in counts_from, or a resumed run would lose it.
 json counts_json(const RunCounts& c) {
   return {{"faces", c.faces}, {"settled", c.settled}, {"unresolved", c.unresolved}, {"invalid", c.invalid}, {"bounces", c.bounces}};
 }
