@@ -36,7 +36,10 @@ std::vector<std::uint8_t> from_hex(const std::string& s) {
 }
 
 // Every field of RunCounts: a field added there (e.g. counted corrections, or N outcomes instead
-// of 6) must be added here and in counts_from, or a resumed run would lose it.
+// of 6) must be added here and in counts_from, or a resumed run would lose it. The assertion
+// makes such a change stop here until it is.
+static_assert(sizeof(RunCounts) == 6 * sizeof(std::uint64_t) + 4 * sizeof(std::uint64_t),
+              "RunCounts changed: serialise the new fields in counts_json / counts_from");
 json counts_json(const RunCounts& c) {
   return {{"faces", c.faces}, {"settled", c.settled}, {"unresolved", c.unresolved}, {"invalid", c.invalid}, {"bounces", c.bounces}};
 }
