@@ -20,7 +20,12 @@ fail() {
 }
 
 # The subscriber, as any external program would run it (only the config file from the repo).
-subscriber() { CYCLONEDDS_URI="file://$src_dir/bridge/cyclonedds-loopback.xml" "$sub" --json "$@"; }
+# Started with `&`, it runs in a subshell: exec there, so that the pid in $! (killed at exit) is
+# the subscriber itself and none is left running after the script.
+subscriber() {
+  if [ "$BASHPID" != "$$" ]; then CYCLONEDDS_URI="file://$src_dir/bridge/cyclonedds-loopback.xml" exec "$sub" --json "$@"; fi
+  CYCLONEDDS_URI="file://$src_dir/bridge/cyclonedds-loopback.xml" "$sub" --json "$@"
+}
 bridge() { "$bin" bridge "$@" 2> "$work/bridge.err" & bridge_pid=$!; pids+=($bridge_pid); }
 nworkers=0
 worker() { nworkers=$((nworkers + 1)); "$bin" worker "$@" 2> "$work/worker$nworkers.err" & pids+=($!); }
