@@ -25,6 +25,11 @@ struct SceneArgs {
   SceneDef load() const;  // throws SceneError
 };
 
+// --key-file FILE (authenticated runs, messages/auth.hpp), with the same help on every command.
+CLI::Option* add_key_file_option(CLI::App* cmd, std::string& path);
+// The key in FILE, or none for an empty path. Throws wire::KeyError (bad input, exit 2).
+std::vector<std::uint8_t> load_run_key(const std::string& path);
+
 void register_toss(CLI::App& app, int& exit_code);
 void register_info(CLI::App& app, int& exit_code);
 void register_bench(CLI::App& app, int& exit_code);
@@ -52,7 +57,11 @@ struct AggregateArgs {
   double target_halfwidth = 0.0;
   double timeout_s = 0.0;
   bool json = false;
+  std::string key_file;    // --key-file: an authenticated run
+  std::string checkpoint;  // --checkpoint FILE (aggregate only)
+  std::string resume;      // --resume FILE (aggregate only): the run, from its checkpoint
   void add_to(CLI::App* cmd);
+  void add_checkpoint_options(CLI::App* cmd);  // --checkpoint, --resume; SCENE becomes optional
 };
 // Starts the run on `url`, aggregates it to the end and prints the report as `toss` does.
 // `workers` (> 0) is reported as the thread count; `on_tick` may return an error to abort.
