@@ -6,6 +6,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "sim/body/outcome.hpp"
 #include "aggregator/session.hpp"
 #include "aggregator/target.hpp"
 #include "apps/commands.hpp"
@@ -57,6 +58,7 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
                          const std::function<std::string()>& on_tick, const std::atomic<bool>* cancel) {
   // Bad input fails here, before anything is published (SceneError -> exit 2 in run_cli).
   const DieModel model = compile(a.scene.load(), a.scene.path);
+  require_six_outcomes(model, a.scene.path);
   std::vector<std::string> overrides = a.scene.overrides;  // as SceneArgs::load composes them
   if (!a.scene.fidelity.empty()) overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
 
@@ -66,7 +68,7 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
                                  a.trace_every);
   const wire::RunSpec& spec = cfg.spec;
   logging::set_run_id(spec.run_id);
-  cfg.labels = model.face_labels;
+  cfg.labels = six_outcome_labels(model);
   cfg.target_halfwidth = a.target_halfwidth;
 
   ProgressBar bar;
@@ -122,7 +124,7 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   r.threads = workers > 0 ? workers : std::max(1, most_workers);
   r.tosses = res.tosses;
   r.counts = res.counts;
-  r.labels = model.face_labels;
+  set_labels(r, model);
   r.elapsed_s = res.elapsed_s;
   print_report(r, a.json);
   return kExitOk;

@@ -24,7 +24,8 @@ struct RunArgs {
 };
 
 int run_run(const RunArgs& a) {
-  (void)compile(a.agg.scene.load(), a.agg.scene.path);  // bad input: exit 2 before any child starts
+  // Bad input: exit 2 before any child starts.
+  require_six_outcomes(compile(a.agg.scene.load(), a.agg.scene.path), a.agg.scene.path);
   const std::int64_t run_id = wire::new_run_id();
   // --lcm or $LCM_DEFAULT_URL if given; else the host-confined group on a port of this run's own.
   std::string url = wire::resolve_url(a.agg.lcm);

@@ -27,7 +27,7 @@ struct TossArgs {
 // --target-halfwidth: blocks of agg::kTargetBlock in index order, stopping at the first block
 // boundary where every face's half-width is <= H; the stopping point is independent of threads.
 RunCounts run_to_target(const DieModel& model, RunConfig cfg, std::uint64_t cap, double h, std::uint64_t& done) {
-  RunCounts total;
+  RunCounts total(model.outcomes());
   const auto progress = cfg.progress;
   for (done = 0; done < cap && !agg::halfwidth_reached(total, h);) {
     cfg.first = done;
@@ -71,7 +71,7 @@ int run_toss(const TossArgs& a) {
   r.threads = a.threads;
   r.tosses = tosses;
   r.counts = counts;
-  r.labels = model.face_labels;
+  set_labels(r, model);
   r.elapsed_s = elapsed;
   print_report(r, a.json);
   return kExitOk;
