@@ -3,9 +3,8 @@
 #include <cstdio>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "apps/commands.hpp"
+#include "apps/info_json.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/models/fidelity_models.hpp"
@@ -13,66 +12,7 @@
 namespace dicesim {
 namespace {
 
-nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
-nlohmann::json mat(const Mat3& m) { return {vec(m.row(0)), vec(m.row(1)), vec(m.row(2))}; }
-
-constexpr int kStaticDirections = 200000;  // Fibonacci lattice for p_static (error ~ 1e-5 per face)
-
-// Resting geometry: per face, the COM height on it and the lowest pass out of its basin.
-nlohmann::json rest_json(const DieModel& m) {
-  nlohmann::json faces = nlohmann::json::array();
-  for (std::size_t f = 0; f < m.face_normals.size(); ++f)
-    faces.push_back({{"label", m.face_labels[f]},
-                     {"height", m.face_height[f]},
-                     {"escape_height", std::isfinite(m.face_escape[f]) ? nlohmann::json(m.face_escape[f]) : nlohmann::json()},
-                     {"tip_ratio", m.face_tip_ratio[f]}});
-  return faces;
-}
-
 Vec3 geometric_normal(const DieModel& m, std::size_t f) { return m.geo_to_body.transpose() * m.face_normals[f]; }
-
-nlohmann::json info_json(const std::string& path, const DieModel& m) {
-  const MassProperties& mp = m.mass_geometric;
-  const std::vector<double> p_static = static_face_probabilities(m, kStaticDirections);
-  nlohmann::json faces = nlohmann::json::array();
-  for (std::size_t f = 0; f < m.face_normals.size(); ++f) {
-    const Vec3 n = geometric_normal(m, f);
-    nlohmann::json face = {{"label", m.face_labels[f]},
-                           {"normal", vec(n)},
-                           {"area", m.face_area[f]},
-                           {"stable", m.face_hold[f] >= 0.0},
-                           {"p_static", p_static[f]}};
-    if (m.kind == "box") face["direction"] = kFaceDirNames[f];
-    faces.push_back(face);
-  }
-  nlohmann::json corners = nlohmann::json::array();
-  for (std::size_t c = 0; c < m.vertices.size(); ++c) {
-    const Vec3 geo = m.geo_to_body.transpose() * m.vertices[c] + mp.com;
-    corners.push_back({{"position", vec(geo)}, {"restitution", m.vertex_restitution[c]}, {"friction", m.vertex_friction[c]}});
-  }
-  return {{"scene", path},
-          {"name", m.name},
-          {"shape", m.kind},
-          {"convex", m.convex},
-          {"rounding", m.rounding},
-          {"read", m.read_down ? "down" : "up"},
-          {"vertex_count", m.vertex_count()},
-          {"face_count", m.face_count()},
-          {"outcomes", m.outcome_labels},
-          {"mass", mp.mass},
-          {"com", vec(mp.com)},
-          {"inertia", mat(mp.inertia)},
-          {"principal_moments", vec(mp.principal_moments)},
-          {"principal_axes", mat(mp.principal_axes)},
-          {"symmetric_top", m.symmetric_top},
-          {"bounding_radius", m.bounding_radius},
-          {"faces", faces},
-          {"corners", corners},
-          {"fidelity", to_string(m.fidelity)},
-          {"fidelity_requested", to_string(m.fidelity_requested)},
-          {"fidelity_reason", m.fidelity_reason},
-          {"rest", rest_json(m)}};
-}
 
 void print_info(const std::string& path, const DieModel& m) {
   const MassProperties& mp = m.mass_geometric;
@@ -93,7 +33,7 @@ void print_info(const std::string& path, const DieModel& m) {
     std::printf("  axis %d           (%+.4f, %+.4f, %+.4f)\n", k + 1, mp.principal_axes(0, k), mp.principal_axes(1, k),
                 mp.principal_axes(2, k));
   std::printf("bounding radius    %.6g m (COM to farthest point)\n\n", m.bounding_radius);
-  const std::vector<double> p_static = static_face_probabilities(m, kStaticDirections);
+  const std::vector<double> p_static = static_face_probabilities(m, kInfoStaticDirections);
   std::printf("faces (outward normal in the geometric frame; area of the flat face; can it hold the die;\n"
               "p_static: probability of reading it in `static` with a uniform orientation; COM height resting on it;\n"
               "lowest COM height out of its basin)\n");

@@ -2,7 +2,18 @@
 // are planar, counter-clockwise seen from outside, with outward unit normals.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
 #include "sim/body/body.hpp"
+#include "sim/body/hull.hpp"
+#include "sim/body/labels.hpp"
+#include "sim/scene/scene_error.hpp"
 #include "sim/body/shape.hpp"
 #include "sim/scene/scene.hpp"
 
@@ -62,6 +73,364 @@ size = [0.03, 0.03, 0.03]
   ASSERT_EQ(b.vertex_restitution.size(), 8u);
   for (double e : b.vertex_restitution) EXPECT_NEAR(e, 0.487, 1e-12);
   for (double mu : b.vertex_friction) EXPECT_NEAR(mu, 0.2, 1e-12);
+}
+
+}  // namespace
+}  // namespace dicesim
+
+// ---- Every shape kind -------------------------------------------------------------------------
+namespace dicesim {
+namespace {
+
+Body body_of(const std::string& die_keys, const std::string& extra = "") {
+  return build_body(parse_scene("[materials.plastic]\ndensity = 1200.0\nrestitution = 0.4\nfriction = 0.5\n" + extra +
+                                    "[die]\nmaterial = \"plastic\"\n" + die_keys,
+                                "test"),
+                    "test");
+}
+
+int euler_characteristic(const ConvexShape& s) {
+  std::size_t edges = 0;
+  for (const auto& f : s.faces) edges += f.size();
+  return static_cast<int>(s.vertices.size()) - static_cast<int>(edges / 2) + static_cast<int>(s.faces.size());
+}
+
+struct PresetCase {
+  const char* shape;
+  std::size_t vertices, faces, corners_per_face;
+  int first_label, opposite_sum;  // opposite_sum 0: no opposite faces (d4)
+};
+
+TEST(BodyShapes, PresetsAreWellFormedWithStandardLabels) {
+  const PresetCase cases[] = {{"d4", 4, 4, 3, 1, 0},    {"d6", 8, 6, 4, 1, 7},     {"d8", 6, 8, 3, 1, 9},
+                              {"d10", 12, 10, 4, 0, 9}, {"d12", 20, 12, 5, 1, 13}, {"d20", 12, 20, 3, 1, 21}};
+  for (const PresetCase& c : cases) {
+    SCOPED_TRACE(c.shape);
+    const double size = 0.02;
+    const Body b = body_of(std::string("shape = \"") + c.shape + "\"\nsize = 0.02\n");
+    EXPECT_EQ(b.kind, c.shape);
+    ASSERT_EQ(b.shape.vertices.size(), c.vertices);
+    ASSERT_EQ(b.shape.faces.size(), c.faces);
+    expect_well_formed(b.shape);
+    EXPECT_EQ(euler_characteristic(b.shape), 2);
+    for (const auto& f : b.shape.faces) EXPECT_EQ(f.size(), c.corners_per_face);
+    // Labels: each of first .. first + N - 1 once.
+    std::vector<int> sorted = b.face_labels;
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t k = 0; k < sorted.size(); ++k) EXPECT_EQ(sorted[k], c.first_label + static_cast<int>(k));
+    EXPECT_EQ(b.read_down, std::string(c.shape) == "d4");
+    for (std::size_t f = 0; f < b.shape.faces.size(); ++f) {
+      const Vec3& n = b.shape.normals[f];
+      const double d = n.dot(b.shape.vertices[b.shape.faces[f][0]]);
+      if (c.opposite_sum == 0) {
+        EXPECT_NEAR(d, size / 4.0, 1e-14);  // face to centroid: a quarter of the height
+        continue;
+      }
+      const int o = nearest_face(b.shape, -n);
+      EXPECT_NEAR(n.dot(b.shape.normals[o]), -1.0, 1e-12) << "opposite faces are parallel";
+      EXPECT_NEAR(d - n.dot(b.shape.vertices[b.shape.faces[o][0]]), size, 1e-14) << "size = distance between them";
+      EXPECT_EQ(b.face_labels[f] + b.face_labels[o], c.opposite_sum);
+    }
+    for (double e : b.vertex_restitution) EXPECT_EQ(e, 0.4);
+    for (double mu : b.vertex_friction) EXPECT_EQ(mu, 0.5);
+  }
+}
+
+TEST(BodyShapes, D4FromItsFarthestVertexIsTheSize) {
+  const Body b = body_of("shape = \"d4\"\nsize = 0.02\n");
+  const Vec3& n = b.shape.normals[0];
+  double lowest = 1.0;
+  for (const Vec3& v : b.shape.vertices) lowest = std::min(lowest, n.dot(v));
+  EXPECT_NEAR(n.dot(b.shape.vertices[b.shape.faces[0][0]]) - lowest, 0.02, 1e-14);
+  EXPECT_FALSE(body_of("shape = \"d4\"\nread = \"up\"\n").read_down);
+  EXPECT_TRUE(body_of("shape = \"d20\"\nread = \"down\"\n").read_down);
+}
+
+TEST(BodyShapes, PrismSidesAndEndsAreLabelledByDirection) {
+  const Body b = body_of("shape = \"prism\"\nsides = 3\nradius = 0.01\nlength = 0.06\n");
+  ASSERT_EQ(b.shape.vertices.size(), 6u);
+  ASSERT_EQ(b.shape.faces.size(), 5u);
+  expect_well_formed(b.shape);
+  EXPECT_EQ(b.face_labels[nearest_face(b.shape, Vec3(1, 0, 0))], 1);
+  EXPECT_EQ(b.face_labels[nearest_face(b.shape, Vec3(std::cos(2.0 * kPi / 3), std::sin(2.0 * kPi / 3), 0))], 2);
+  EXPECT_EQ(b.face_labels[nearest_face(b.shape, Vec3(std::cos(4.0 * kPi / 3), std::sin(4.0 * kPi / 3), 0))], 3);
+  EXPECT_EQ(b.face_labels[nearest_face(b.shape, Vec3(0, 0, 1))], 4);
+  EXPECT_EQ(b.face_labels[nearest_face(b.shape, Vec3(0, 0, -1))], 5);
+  const Body many = body_of("shape = \"prism\"\nsides = 40\n");
+  EXPECT_EQ(many.shape.faces.size(), 42u);
+  expect_well_formed(many.shape);
+}
+
+TEST(BodyShapes, HullOfRandomPointsIsWellFormedAndHoldsThemAll) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (int trial = 0; trial < 5; ++trial) {
+    std::vector<Vec3> points;
+    for (int i = 0; i < 200; ++i) points.push_back(0.01 * Vec3(g(rng), g(rng), g(rng)).normalized() * (0.5 + 0.5 * std::abs(g(rng))));
+    const ConvexShape s = convex_hull(points);
+    expect_well_formed(s);
+    EXPECT_EQ(euler_characteristic(s), 2);
+    for (std::size_t f = 0; f < s.faces.size(); ++f) {
+      const double d = s.normals[f].dot(s.vertices[s.faces[f][0]]);
+      for (const Vec3& p : points) EXPECT_LE(s.normals[f].dot(p), d + 1e-15);
+    }
+    // Every hull vertex is one of the points.
+    for (const Vec3& v : s.vertices) EXPECT_NE(std::find(points.begin(), points.end(), v), points.end());
+  }
+}
+
+TEST(BodyShapes, HullMergesCoplanarTrianglesAndDropsPointsOnEdgesAndFaces) {
+  std::vector<Vec3> points;
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z) points.push_back(0.01 * Vec3(x, y, z));  // corners, edge and face midpoints
+  points.push_back(Vec3(0.01, 0.003, 0.004 + 3e-9));  // inside the +x face, within the tolerance
+  const ConvexShape s = convex_hull(points);
+  EXPECT_EQ(s.vertices.size(), 8u);
+  EXPECT_EQ(s.faces.size(), 6u);
+  expect_well_formed(s);
+  EXPECT_EQ(s.normals[0], Vec3(0, 0, 1)) << "canonical order: top face first";
+}
+
+TEST(BodyShapes, HullOrderDoesNotDependOnInputOrder) {
+  const Body a = body_of("shape = \"d20\"\n");
+  std::vector<Vec3> shuffled = a.shape.vertices;
+  std::mt19937_64 rng(3);
+  std::shuffle(shuffled.begin(), shuffled.end(), rng);
+  const ConvexShape b = convex_hull(shuffled);
+  EXPECT_EQ(b.vertices, a.shape.vertices);
+  EXPECT_EQ(b.faces, a.shape.faces);
+}
+
+TEST(BodyShapes, HullKeysGiveTheirShapeScaledAndLabelledInFaceOrder) {
+  const Body b = body_of(
+      "shape = \"hull\"\nscale = 0.001\n"
+      "vertices = [[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]]\n");
+  ASSERT_EQ(b.shape.faces.size(), 4u);
+  EXPECT_NEAR(b.mass.mass, 1200.0 * 1e-6 / 6.0, 1e-15);
+  EXPECT_EQ(b.face_labels, (std::vector<int>{1, 2, 3, 4}));
+  expect_well_formed(b.shape);
+}
+
+TEST(BodyLabels, NearestNormalSharedLabelsAndNumberingOfTheRest) {
+  const std::string tet = "shape = \"hull\"\nvertices = [[0, 0, 0], [0.01, 0, 0], [0, 0.01, 0], [0, 0, 0.01]]\n";
+  const Body b = body_of(tet +
+                         "[[die.labels]]\nnormal = [0, 0, -1]\nlabel = 7\n"
+                         "[[die.labels]]\nnormal = [0, -1, 0.1]\nlabel = 7\n");
+  EXPECT_EQ(b.face_labels[nearest_face(b.shape, Vec3(0, 0, -1))], 7);
+  EXPECT_EQ(b.face_labels[nearest_face(b.shape, Vec3(0, -1, 0))], 7);
+  // The other two, in face order: 1 and 2.
+  std::vector<int> rest;
+  for (std::size_t f = 0; f < 4; ++f)
+    if (b.face_labels[f] != 7) rest.push_back(b.face_labels[f]);
+  EXPECT_EQ(rest, (std::vector<int>{1, 2}));
+  // Presets keep their standard labels except the one named.
+  const Body d8 = body_of("shape = \"d8\"\n[[die.labels]]\nnormal = [1, 1, 1]\nlabel = 42\n");
+  EXPECT_EQ(d8.face_labels[nearest_face(d8.shape, Vec3(1, 1, 1))], 42);
+  EXPECT_EQ(std::count(d8.face_labels.begin(), d8.face_labels.end(), 42), 1);
+  // The box: [[die.labels]] on top of [die.faces].
+  const Body box = body_of("[[die.labels]]\nnormal = [0, 0, 1]\nlabel = 9\n");
+  EXPECT_EQ(box.face_labels, (std::vector<int>{2, 5, 3, 4, 9, 6}));
+}
+
+TEST(BodyLabels, TwoLabelsOnOneFaceIsAnError) {
+  try {
+    body_of("shape = \"d6\"\n[[die.labels]]\nnormal = [0, 0, 1]\nlabel = 1\n[[die.labels]]\nnormal = [0.1, 0, 1]\nlabel = 2\n");
+    FAIL() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.key(), "die.labels[1].normal");
+    EXPECT_NE(e.allowed().find("same face"), std::string::npos) << e.what();
+    EXPECT_NE(e.allowed().find("die.labels[0]"), std::string::npos) << e.what();
+  }
+}
+
+TEST(BodyMaterials, RegionsGiveEachVertexTheMaterialAroundIt) {
+  // A d8 whose lower half (z < 0) is steel: the bottom corner is steel, the top corner plastic,
+  // the four equator corners half and half.
+  const Body b = body_of("shape = \"d8\"\n[[die.regions]]\nmaterial = \"steel\"\ncuts = [{normal = [0, 0, 1], offset = 0.0}]\n",
+                         "[materials.steel]\ndensity = 7800.0\nrestitution = 0.8\nfriction = 0.1\n");
+  for (std::size_t v = 0; v < b.shape.vertices.size(); ++v) {
+    const double z = b.shape.vertices[v].z();
+    const double expected = z > 1e-9 ? 0.4 : z < -1e-9 ? 0.8 : 0.6;
+    EXPECT_NEAR(b.vertex_restitution[v], expected, 1e-9) << "vertex " << v;
+  }
+}
+
+}  // namespace
+}  // namespace dicesim
+
+// ---- Bad input that only the body can see -----------------------------------------------------
+namespace dicesim {
+namespace {
+
+SceneError body_error(const std::string& die_keys, const std::string& extra = "") {
+  try {
+    body_of(die_keys, extra);
+  } catch (const SceneError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no SceneError for: " << die_keys;
+  return SceneError("", "", "", "");
+}
+
+void expect_has(const std::string& text, const std::string& part) {
+  EXPECT_NE(text.find(part), std::string::npos) << "'" << part << "' not in: " << text;
+}
+
+TEST(BodyErrors, FlatOrDegenerateHulls) {
+  const SceneError flat = body_error("shape = \"hull\"\nvertices = [[0,0,0],[0.01,0,0],[0,0.01,0],[0.01,0.01,0]]\n");
+  EXPECT_EQ(flat.key(), "die.vertices");
+  expect_has(flat.allowed(), "one plane");
+  const SceneError line = body_error("shape = \"hull\"\nvertices = [[0,0,0],[0.01,0,0],[0.02,0,0],[0.03,0,0]]\n");
+  expect_has(line.allowed(), "one line");
+  const SceneError same = body_error("shape = \"hull\"\nvertices = [[0,0,0],[0,0,0],[0,0,0],[0,0,0]]\n");
+  expect_has(same.allowed(), "coincide");
+}
+
+TEST(BodyErrors, RoundingNotBelowTheInradius) {
+  // A d6 of size 0.02 has inradius 0.01.
+  const SceneError e = body_error("shape = \"d6\"\nsize = 0.02\nrounding = 0.01\n");
+  EXPECT_EQ(e.key(), "die.rounding");
+  EXPECT_EQ(e.value(), "0.01");
+  expect_has(e.allowed(), "inradius");
+  expect_has(e.allowed(), "0.01 m");
+  EXPECT_NO_THROW(body_of("shape = \"d6\"\nsize = 0.02\nrounding = 0.0099\n"));
+  // A flat box: the inradius is half its thinnest edge.
+  const SceneError box = body_error("size = [0.03, 0.03, 0.004]\nrounding = 0.0025\n");
+  expect_has(box.allowed(), "0.002 m");
+}
+
+TEST(BodyErrors, RegionThatLeavesNothingOfTheDie) {
+  const SceneError e = body_error("shape = \"d20\"\nsize = 0.02\n[[die.regions]]\nmaterial = \"plastic\"\n"
+                                  "cuts = [{normal = [0, 0, 1], offset = -0.02}]\n");
+  EXPECT_EQ(e.key(), "die.regions[0].cuts");
+  expect_has(e.allowed(), "no part of the die");
+}
+
+std::string write_obj(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+const char* kCubeObj = R"(v -1 -1 -1
+v 1 -1 -1
+v 1 1 -1
+v -1 1 -1
+v -1 -1 1
+v 1 -1 1
+v 1 1 1
+v -1 1 1
+f 1 4 3 2
+f 5 6 7 8
+f 1 2 6 5
+f 2 3 7 6
+f 3 4 8 7
+f 4 1 5 8
+)";
+
+SceneError obj_error(const std::string& text) {
+  const std::string path = write_obj("bad.obj", text);
+  const SceneError e = body_error("shape = \"mesh\"\nmesh = \"" + path + "\"\nscale = 0.01\n");
+  EXPECT_EQ(e.file(), path);
+  return e;
+}
+
+TEST(BodyErrors, ObjThatDoesNotParseOrIsNotClosedNamesTheLine) {
+  const std::string cube = kCubeObj;
+  EXPECT_NO_THROW(body_of("shape = \"mesh\"\nmesh = \"" + write_obj("cube.obj", cube) + "\"\nscale = 0.01\n"));
+
+  const SceneError number = obj_error("v 0 0 x\n" + cube);
+  EXPECT_EQ(number.key(), "line 1");
+  EXPECT_EQ(number.value(), "v 0 0 x");
+  expect_has(number.allowed(), "not a finite number");
+
+  const SceneError index = obj_error(cube + "f 1 2 99\n");
+  EXPECT_EQ(index.key(), "line 15");
+  expect_has(index.allowed(), "out of range");
+
+  const SceneError statement = obj_error(cube + "curv 0 1 2\n");
+  expect_has(statement.allowed(), "unknown OBJ statement 'curv'");
+
+  // Drop the last face: the mesh has a hole.
+  const SceneError open = obj_error(cube.substr(0, cube.rfind("f 4 1 5 8")));
+  expect_has(open.allowed(), "closed");
+  EXPECT_EQ(open.key().rfind("line ", 0), 0u);
+
+  // Reverse one face: inconsistent orientation.
+  std::string flipped = cube;
+  flipped.replace(flipped.find("f 5 6 7 8"), 9, "f 8 7 6 5");
+  const SceneError orient = obj_error(flipped);
+  expect_has(orient.allowed(), "consistently oriented");
+
+  // Reverse all faces: inside out.
+  std::string inverted;
+  std::istringstream in(cube);
+  for (std::string l; std::getline(in, l);) {
+    if (l[0] == 'f') {
+      std::istringstream w(l.substr(2));
+      std::vector<std::string> ids;
+      for (std::string t; w >> t;) ids.push_back(t);
+      std::reverse(ids.begin(), ids.end());
+      l = "f";
+      for (const auto& t : ids) l += " " + t;
+    }
+    inverted += l + "\n";
+  }
+  expect_has(obj_error(inverted).allowed(), "inward");
+}
+
+}  // namespace
+}  // namespace dicesim
+
+// ---- Ready scenes (scenes/dice/) ---------------------------------------------------------------
+namespace dicesim {
+namespace {
+
+Body ready(const std::string& name) {
+  const std::string path = std::string(DICESIM_SOURCE_DIR) + "/scenes/dice/" + name;
+  return build_body(load_scene(path), path);
+}
+
+TEST(BodyReadyScenes, EveryDiceSceneBuilds) {
+  struct Case {
+    const char* file;
+    std::size_t faces;
+    bool read_down;
+    double rounding;
+  };
+  const Case cases[] = {{"d4.toml", 4, true, 0.0},          {"d6.toml", 6, false, 0.0015},
+                        {"d8.toml", 8, false, 0.0},         {"d10.toml", 10, false, 0.0},
+                        {"d12.toml", 12, false, 0.0},       {"d20.toml", 20, false, 0.0},
+                        {"loaded-d20.toml", 20, false, 0.0}, {"steel-cuboid.toml", 6, false, 0.0},
+                        {"prism3.toml", 5, true, 0.0}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.file);
+    const Body b = ready(c.file);
+    EXPECT_EQ(b.shape.faces.size(), c.faces);
+    EXPECT_EQ(b.read_down, c.read_down);
+    EXPECT_EQ(b.shape.rounding, c.rounding);
+    expect_well_formed(b.shape);
+    EXPECT_GT(b.mass.mass, 0.0);
+  }
+}
+
+TEST(BodyReadyScenes, LoadedD20IsHeavyTowardsItsSlabFace) {
+  const Body fair = ready("d20.toml");
+  const Body loaded = ready("loaded-d20.toml");
+  const double phi = (1.0 + std::sqrt(5.0)) / 2.0;
+  const Vec3 n = Vec3(1.0 / phi, 0.0, -phi).normalized();
+  EXPECT_LE(fair.mass.com.norm(), 1e-15);
+  // The slab (steel in n.x >= 8 mm) pulls the COM towards the face with normal n.
+  EXPECT_GT(loaded.mass.com.dot(n), 1e-4);
+  EXPECT_LE((loaded.mass.com - loaded.mass.com.dot(n) * n).norm(), 1e-12) << "and only along n";
+  EXPECT_NEAR(loaded.shape.normals[nearest_face(loaded.shape, n)].dot(n), 1.0, 1e-12) << "n is a face normal";
+  EXPECT_GT(loaded.mass.mass, fair.mass.mass);
+  EXPECT_EQ(loaded.face_labels[nearest_face(loaded.shape, n)], 19) << "as the scene says";
+  EXPECT_EQ(loaded.face_labels[nearest_face(loaded.shape, -n)], 2);
+  // Its contact corners are steel (those of the slab face) or plastic.
+  const int f = nearest_face(loaded.shape, n);
+  for (int v : loaded.shape.faces[f]) EXPECT_NEAR(loaded.vertex_restitution[v], 0.6, 1e-12);
 }
 
 }  // namespace

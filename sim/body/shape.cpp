@@ -1,5 +1,10 @@
 #include "sim/body/shape.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <tuple>
+
 namespace dicesim {
 
 ConvexShape box_shape(const Vec3& size) {
@@ -26,6 +31,70 @@ ConvexShape box_shape(const Vec3& size) {
     s.normals.push_back(n);
   }
   return s;
+}
+
+Triangles shape_triangles(const ConvexShape& s) {
+  Triangles out;
+  for (const auto& loop : s.faces)
+    for (std::size_t k = 1; k + 1 < loop.size(); ++k)
+      out.push_back({s.vertices[loop[0]], s.vertices[loop[k]], s.vertices[loop[k + 1]]});
+  return out;
+}
+
+double face_area(const ConvexShape& s, std::size_t i) {
+  const auto& loop = s.faces[i];
+  Vec3 a = Vec3::Zero();
+  for (std::size_t k = 1; k + 1 < loop.size(); ++k)
+    a += (s.vertices[loop[k]] - s.vertices[loop[0]]).cross(s.vertices[loop[k + 1]] - s.vertices[loop[0]]);
+  return 0.5 * a.norm();
+}
+
+namespace {
+
+long long quantize(double x) { return std::llround(x * 1e9); }
+
+std::tuple<long long, long long, long long> direction_key(const Vec3& v, double scale) {
+  const Vec3 u = v / scale;
+  const bool on_axis = std::hypot(u.x(), u.y()) <= 1e-12;
+  return {-quantize(u.z()), on_axis ? 0 : quantize(std::atan2(u.y(), u.x())), quantize(std::hypot(u.x(), u.y()))};
+}
+
+}  // namespace
+
+void canonical_order(ConvexShape& s) {
+  double scale = 0.0;
+  for (const Vec3& v : s.vertices) scale = std::max(scale, v.norm());
+  if (!(scale > 0.0)) scale = 1.0;
+  std::vector<int> vorder(s.vertices.size());
+  std::iota(vorder.begin(), vorder.end(), 0);
+  std::stable_sort(vorder.begin(), vorder.end(), [&](int a, int b) {
+    return direction_key(s.vertices[a], scale) < direction_key(s.vertices[b], scale);
+  });
+  std::vector<int> new_index(s.vertices.size());
+  std::vector<Vec3> vertices(s.vertices.size());
+  for (std::size_t k = 0; k < vorder.size(); ++k) {
+    new_index[vorder[k]] = static_cast<int>(k);
+    vertices[k] = s.vertices[vorder[k]];
+  }
+  for (auto& loop : s.faces) {
+    for (int& v : loop) v = new_index[v];
+    std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end()), loop.end());
+  }
+  std::vector<int> forder(s.faces.size());
+  std::iota(forder.begin(), forder.end(), 0);
+  std::stable_sort(forder.begin(), forder.end(), [&](int a, int b) {
+    const auto ka = direction_key(s.normals[a], 1.0), kb = direction_key(s.normals[b], 1.0);
+    return std::make_pair(std::get<0>(ka), std::get<1>(ka)) < std::make_pair(std::get<0>(kb), std::get<1>(kb));
+  });
+  std::vector<std::vector<int>> faces;
+  std::vector<Vec3> normals;
+  for (int f : forder) {
+    faces.push_back(std::move(s.faces[f]));
+    normals.push_back(s.normals[f]);
+  }
+  s.vertices = std::move(vertices);
+  s.faces = std::move(faces);
+  s.normals = std::move(normals);
 }
 
 }  // namespace dicesim
