@@ -38,7 +38,7 @@ std::vector<std::uint8_t> from_hex(const std::string& s) {
 // Every field of RunCounts: a field added there (e.g. counted corrections, or N outcomes instead
 // of 6) must be added here and in counts_from, or a resumed run would lose it. The assertion
 // makes such a change stop here until it is.
-static_assert(sizeof(RunCounts) == 6 * sizeof(std::uint64_t) + 4 * sizeof(std::uint64_t),
+static_assert(sizeof(RunCounts) == sizeof(std::vector<std::uint64_t>) + 4 * sizeof(std::uint64_t),
               "RunCounts changed: serialise the new fields in counts_json / counts_from");
 json counts_json(const RunCounts& c) {
   return {{"faces", c.faces}, {"settled", c.settled}, {"unresolved", c.unresolved}, {"invalid", c.invalid}, {"bounces", c.bounces}};
@@ -46,7 +46,7 @@ json counts_json(const RunCounts& c) {
 
 RunCounts counts_from(const json& j) {
   RunCounts c;
-  c.faces = j.at("faces").get<std::array<std::uint64_t, 6>>();
+  c.faces = j.at("faces").get<std::vector<std::uint64_t>>();
   c.settled = j.at("settled").get<std::uint64_t>();
   c.unresolved = j.at("unresolved").get<std::uint64_t>();
   c.invalid = j.at("invalid").get<std::uint64_t>();

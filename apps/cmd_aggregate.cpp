@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include "aggregator/checkpoint.hpp"
+#include "sim/body/outcome.hpp"
 #include "aggregator/session.hpp"
 #include "aggregator/target.hpp"
 #include "apps/commands.hpp"
@@ -77,7 +78,7 @@ void AggregateArgs::add_checkpoint_options(CLI::App* cmd) {
 DieModel rebuild_checkpoint_model(const agg::Checkpoint& ck, const std::string& path) {
   const wire::RunSpec spec = wire::from_message(ck.start);
   DieModel model = wire::compile_spec(spec);
-  if (wire::model_fingerprint(model) != spec.fingerprint || model.face_labels != ck.labels)
+  if (wire::model_fingerprint(model) != spec.fingerprint || six_outcome_labels(model) != ck.labels)
     throw std::runtime_error("checkpoint '" + path + "': this dicesim build compiles the run's scene to a different model "
                              "(fingerprint): resume it with the build that started it");
   return model;
@@ -111,7 +112,8 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   }
   const wire::RunSpec& spec = cfg.spec;
   logging::set_run_id(spec.run_id);
-  cfg.labels = model.face_labels;
+  require_six_outcomes(model, resume ? a.resume : a.scene.path);
+  cfg.labels = six_outcome_labels(model);
 
   ProgressBar bar;
   std::size_t refusals_shown = 0;
@@ -193,7 +195,7 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   r.threads = workers > 0 ? workers : std::max(1, most_workers);
   r.tosses = res.tosses;
   r.counts = res.counts;
-  r.labels = model.face_labels;
+  set_labels(r, model);
   r.elapsed_s = res.run_elapsed_s;
   print_report(r, a.json);
   return kExitOk;

@@ -81,7 +81,7 @@ int replay_run(const ReplayArgs& a) {
   r.threads = std::max(1, res.workers);
   r.tosses = res.tosses;
   r.counts = res.counts;
-  r.labels = res.labels;
+  r.labels.assign(res.labels.begin(), res.labels.end());
   r.elapsed_s = elapsed;
   print_report(r, a.json);
   return kExitOk;

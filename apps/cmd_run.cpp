@@ -24,8 +24,9 @@ struct RunArgs {
 };
 
 int run_run(const RunArgs& a) {
-  (void)compile(a.agg.scene.load(), a.agg.scene.path);  // bad input: exit 2 before any child starts
-  (void)load_run_key(a.agg.key_file);                     // likewise a bad key file
+  // Bad input (scene or key file): exit 2 before any child starts.
+  require_six_outcomes(compile(a.agg.scene.load(), a.agg.scene.path), a.agg.scene.path);
+  (void)load_run_key(a.agg.key_file);
   const std::int64_t run_id = wire::new_run_id();
   // --lcm or $LCM_DEFAULT_URL if given; else the host-confined group on a port of this run's own.
   std::string url = wire::resolve_url(a.agg.lcm);

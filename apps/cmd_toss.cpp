@@ -55,7 +55,7 @@ int run_toss(const TossArgs& a) {
   r.threads = a.threads;
   r.tosses = tosses;
   r.counts = counts;
-  r.labels = model.face_labels;
+  set_labels(r, model);
   r.elapsed_s = elapsed;
   print_report(r, a.json);
   return kExitOk;

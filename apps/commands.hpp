@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "sim/body/die_model.hpp"
 #include "sim/scene/scene.hpp"
 
 namespace dicesim {
@@ -45,6 +46,10 @@ void register_bridge(CLI::App& app, int& exit_code);  // cmd_bridge.cpp
 void register_watch(CLI::App& app, int& exit_code);   // cmd_watch.cpp
 void register_record(CLI::App& app, int& exit_code);  // cmd_record.cpp
 void register_replay(CLI::App& app, int& exit_code);  // cmd_replay.cpp
+
+// The LCM wire carries six outcomes until it carries N: `run`, `aggregate` and `sweep --workers`
+// refuse any other die with a SceneError (exit 2) naming the scene and the die's outcome count.
+void require_six_outcomes(const DieModel& m, const std::string& scene_path);
 
 // Distributed runs (cmd_aggregate.cpp): what `aggregate` and `run` share.
 struct AggregateArgs {

@@ -1,3 +1,4 @@
+#include "sim/body/outcome.hpp"
 #include "logger/replay.hpp"
 
 #include <algorithm>
@@ -194,7 +195,7 @@ ReplayResult replay(const ReplayOptions& opt) {
   const dicesim_lcm::run_start start = find_run(opt.path, opt.run_id, opt.key);
   const Rebuilt rb = rebuild(start);
   res.spec = rb.spec;
-  res.labels = rb.model.face_labels;
+  res.labels = six_outcome_labels(rb.model);
   res.model_matches = rb.matches;
   logging::set_run_id(rb.spec.run_id);
   spdlog::info("replaying run {}: {} ({}), seed {}, {} tosses", rb.spec.run_id, rb.spec.origin, rb.spec.fidelity,
@@ -202,7 +203,7 @@ ReplayResult replay(const ReplayOptions& opt) {
 
   agg::AggregatorConfig cfg;
   cfg.spec = rb.spec;
-  cfg.labels = rb.model.face_labels;
+  cfg.labels = six_outcome_labels(rb.model);
   cfg.key = opt.key;
   std::unique_ptr<lcm::LCM> bus;
   if (opt.live) {
@@ -216,7 +217,7 @@ ReplayResult replay(const ReplayOptions& opt) {
     // carry): its last message says where, S. The widest half-width at S, H* <= H, stops the
     // aggregator's own rule at exactly S: every earlier boundary was wider than H >= H*.
     res.stopped_at_target = true;
-    cfg.target_halfwidth = agg::max_halfwidth(recorded_counts(*res.recorded_final, rb.model.face_labels));
+    cfg.target_halfwidth = agg::max_halfwidth(recorded_counts(*res.recorded_final, six_outcome_labels(rb.model)));
     spdlog::info("the live run stopped early at {} tosses (a target half-width); replaying to the same stop",
                  res.recorded_final->total);
     p = feed(opt, cfg, nullptr, res);

@@ -111,12 +111,9 @@ void register_scene(pb::module_& m) {
       .def_property_readonly(
           "labels",
           [](Scene& s) {
-            const auto& l = s.model()->face_labels;
-            std::vector<int> v(l.begin(), l.end());
-            std::sort(v.begin(), v.end());
-            return v;
+            return s.model()->outcome_labels;  // distinct, ascending
           },
-          "The face labels, ascending (the order of Result.counts).")
+          "The outcome labels: distinct face labels, ascending (the order of Result.counts).")
       .def(
           "info",
           [](Scene& s, std::optional<std::string> fidelity) { return json_to_python(info_json(s.origin(), *s.model(fidelity))); },

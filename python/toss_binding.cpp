@@ -87,7 +87,7 @@ RunReport make_report(const Scene& scene, const DieModel& model, std::uint64_t s
   r.threads = threads;
   r.tosses = tosses;
   r.counts = counts;
-  r.labels = model.face_labels;
+  set_labels(r, model);
   r.elapsed_s = elapsed_s;
   return r;
 }

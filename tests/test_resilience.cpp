@@ -15,6 +15,7 @@
 #include "aggregator/checkpoint.hpp"
 #include "messages/auth.hpp"
 #include "messages/run_spec.hpp"
+#include "sim/body/outcome.hpp"
 #include "sim/study/monte_carlo.hpp"
 #include "sim/worker/worker.hpp"
 
@@ -122,7 +123,7 @@ struct TestRun {
     spec.total = total;
     model = wire::compile_spec(spec);
     spec.fingerprint = wire::model_fingerprint(model);
-    cfg.labels = model.face_labels;
+    cfg.labels = six_outcome_labels(model);
     cfg.max_lease = 700;
     cfg.min_lease = 150;
   }

@@ -55,7 +55,7 @@ int FixedStepper::step(RigidState& s) {
   // Penetration is projected out (the energy test counts it, so it cannot hide energy).
   if (s.position.z() <= m.bounding_radius) {
     double low = 0.0;
-    for (const Vec3& v : m.vertices) low = std::min(low, s.position.z() + s.R.row(2).dot(v));
+    for (const Vec3& v : m.vertices) low = std::min(low, s.position.z() + s.R.row(2).dot(v) - m.rounding);
     s.position.z() -= low;
   }
   return n;
@@ -84,8 +84,9 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
     if (n == 0) {
       if (!allow_liftoff) continue;
       bool clear = true;
-      for (int i = 0; i < 8 && clear; ++i) {
-        const Vec3 ri = s.R * m.vertices[i];
+      const int nv = m.vertex_count();
+      for (int i = 0; i < nv && clear; ++i) {
+        const Vec3 ri = contact_point(m, s.R, i);
         const double z = s.position.z() + ri.z();
         const double vz = (s.velocity + s.omega.cross(ri)).z();
         clear = z + 2.0 * h * std::min(0.0, vz) - 2.0 * g * h * h > 1e-9 * r;

@@ -235,8 +235,24 @@ bool solve_plastic_single(const Body& b, const Points& pts, double pn[], Eigen::
 
 ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol) {
   ContactSet c;
-  for (int i = 0; i < 8; ++i)
-    if (s.position.z() + s.R.row(2).dot(m.vertices[i]) <= tol) c.vertex[c.n++] = i;
+  double z[kMaxContacts];
+  const int nv = m.vertex_count();
+  for (int i = 0; i < nv; ++i) {
+    const double zi = corner_height(m, s, i);
+    if (zi > tol) continue;
+    if (c.n < kMaxContacts) {
+      z[c.n] = zi;
+      c.vertex[c.n++] = i;
+      continue;
+    }
+    int hi = 0;  // full: replace the highest if this one is lower
+    for (int k = 1; k < c.n; ++k)
+      if (z[k] > z[hi]) hi = k;
+    if (zi < z[hi]) {
+      z[hi] = zi;
+      c.vertex[hi] = i;
+    }
+  }
   return c;
 }
 
@@ -250,7 +266,7 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
   pts.n = c.n;
   for (int i = 0; i < c.n; ++i) {
     const int v = c.vertex[i];
-    pts.r[i] = s.R * m.vertices[v];
+    pts.r[i] = contact_point(m, s.R, v);
     pts.e[i] = m.vertex_restitution[v];
     pts.mu[i] = m.vertex_friction[v];
     const Mat3 W = compliance(b, pts.r[i]);

@@ -23,7 +23,9 @@
 
 namespace dicesim {
 
-inline constexpr int kMaxContacts = 8;
+// A face of more corners touches at the kMaxContacts lowest (enough to carry any load on a
+// flat floor; a many-sided face is rare: a prism's end, a hull's big face).
+inline constexpr int kMaxContacts = 16;
 
 // The corners of the die that touch the floor at one instant.
 struct ContactSet {
@@ -38,7 +40,8 @@ struct ImpactResult {
   bool energy_clamped = false;  // the energy guard scaled the impulse back
 };
 
-// Corners of `s` whose height is at most `tol` (m).
+// Corners of `s` whose contact point (the lowest point of the corner's ball) is at most `tol` (m)
+// above the floor; of more than kMaxContacts, the lowest.
 ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol);
 
 // Impact with restitution (true) or perfectly plastic (false, used for sustained contact), with
@@ -47,7 +50,7 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
 
 // Velocity of corner `vertex`'s contact point (world).
 inline Vec3 corner_velocity(const DieModel& m, const RigidState& s, int vertex) {
-  return s.velocity + s.omega.cross(s.R * m.vertices[vertex]);
+  return s.velocity + s.omega.cross(contact_point(m, s.R, vertex));
 }
 
 }  // namespace dicesim

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "sim/body/body.hpp"
 #include "sim/models/fidelity_auto.hpp"
@@ -20,15 +23,104 @@ std::string fmt(double v) {
   return buf;
 }
 
+
+// Corner adjacency, edge positions and the face across every edge, from the face loops. A loop
+// edge a -> b must meet exactly one b -> a in another face (a closed, consistently oriented hull).
+void build_topology(DieModel& m, const ConvexShape& shape, const std::string& origin, const std::string& kind) {
+  const int nv = static_cast<int>(shape.vertices.size());
+  m.face_begin.assign(1, 0);
+  m.face_loop.clear();
+  m.loop_face.clear();
+  for (std::size_t f = 0; f < shape.faces.size(); ++f) {
+    if (shape.faces[f].size() < 3)
+      throw SceneError(origin, "die.shape", kind, "a face with fewer than 3 corners");
+    for (const int v : shape.faces[f]) {
+      if (v < 0 || v >= nv) throw SceneError(origin, "die.shape", kind, "a face refers to a missing corner");
+      m.face_loop.push_back(v);
+      m.loop_face.push_back(static_cast<int>(f));
+    }
+    m.face_begin.push_back(static_cast<int>(m.face_loop.size()));
+  }
+  std::map<std::pair<int, int>, int> edge_pos;  // directed edge -> loop position
+  for (std::size_t f = 0; f < shape.faces.size(); ++f) {
+    const int b0 = m.face_begin[f], k = m.face_begin[f + 1] - b0;
+    for (int i = 0; i < k; ++i) {
+      const int a = m.face_loop[static_cast<std::size_t>(b0 + i)];
+      const int b = m.face_loop[static_cast<std::size_t>(b0 + (i + 1) % k)];
+      if (!edge_pos.emplace(std::make_pair(a, b), b0 + i).second)
+        throw SceneError(origin, "die.shape", kind, "two faces share an edge in the same direction (not a consistently oriented hull)");
+    }
+  }
+  m.face_across.assign(m.face_loop.size(), -1);
+  std::vector<std::vector<std::pair<int, int>>> adj(static_cast<std::size_t>(nv));  // (neighbour, edge position)
+  for (const auto& [ab, pos] : edge_pos) {
+    const auto it = edge_pos.find({ab.second, ab.first});
+    if (it == edge_pos.end())
+      throw SceneError(origin, "die.shape", kind, "an edge belongs to one face only (the hull is not closed)");
+    m.face_across[static_cast<std::size_t>(pos)] = m.loop_face[static_cast<std::size_t>(it->second)];
+    adj[static_cast<std::size_t>(ab.first)].push_back({ab.second, pos});
+  }
+  m.vertex_adj_begin.assign(1, 0);
+  m.vertex_adj.clear();
+  m.vertex_adj_edge.clear();
+  for (auto& list : adj) {
+    std::sort(list.begin(), list.end());
+    for (const auto& [j, pos] : list) {
+      m.vertex_adj.push_back(j);
+      m.vertex_adj_edge.push_back(pos);
+    }
+    m.vertex_adj_begin.push_back(static_cast<int>(m.vertex_adj.size()));
+  }
+}
+
+// Outcomes: distinct labels ascending; the face read when each face lies on the floor.
+void build_outcomes(DieModel& m) {
+  m.outcome_labels = m.face_labels;
+  std::sort(m.outcome_labels.begin(), m.outcome_labels.end());
+  m.outcome_labels.erase(std::unique(m.outcome_labels.begin(), m.outcome_labels.end()), m.outcome_labels.end());
+  const int nf = m.face_count();
+  m.face_outcome.resize(static_cast<std::size_t>(nf));
+  m.face_result.resize(static_cast<std::size_t>(nf));
+  for (int f = 0; f < nf; ++f) {
+    const std::size_t fi = static_cast<std::size_t>(f);
+    m.face_outcome[fi] = static_cast<int>(
+        std::lower_bound(m.outcome_labels.begin(), m.outcome_labels.end(), m.face_labels[fi]) - m.outcome_labels.begin());
+    if (m.read_down) {
+      m.face_result[fi] = f;
+      continue;
+    }
+    int up = f;
+    double best = 2.0;
+    for (int g = 0; g < nf; ++g) {
+      const double z = m.face_normals[fi].dot(m.face_normals[static_cast<std::size_t>(g)]);
+      if (z < best) {
+        best = z;
+        up = g;
+      }
+    }
+    m.face_result[fi] = up;
+  }
+}
+
 }  // namespace
 
 DieModel compile(const SceneDef& scene, const std::string& origin) {
-  const Body body = build_body(scene, origin);
-  if (body.shape.vertices.size() != 8 || body.shape.faces.size() != 6)
-    throw SceneError(origin, "die.shape", body.kind, "only a six-faced box can be simulated yet");
+  return compile_body(build_body(scene, origin), scene, origin);
+}
+
+DieModel compile_body(const Body& body, const SceneDef& scene, const std::string& origin) {
+  const ConvexShape& shape = body.shape;
+  const std::size_t nv = shape.vertices.size(), nf = shape.faces.size();
+  if (nv < 4 || nf < 4 || shape.normals.size() != nf || body.face_labels.size() != nf ||
+      body.vertex_restitution.size() != nv || body.vertex_friction.size() != nv)
+    throw SceneError(origin, "die.shape", body.kind, "the body is incomplete (corners, faces, normals, labels or materials missing)");
 
   DieModel m;
   m.name = scene.name;
+  m.kind = body.kind;
+  m.convex = body.convex;
+  m.read_down = body.read_down;
+  m.rounding = shape.rounding;
   m.mass_geometric = body.mass;
   const MassProperties& mp = m.mass_geometric;
 
@@ -37,16 +129,22 @@ DieModel compile(const SceneDef& scene, const std::string& origin) {
   m.geo_to_body = mp.principal_axes.transpose();
   m.symmetric_top = is_symmetric_top(m.principal_moments);
 
-  for (int c = 0; c < 8; ++c) {
-    m.vertices[c] = m.geo_to_body * (body.shape.vertices[c] - mp.com);
+  m.vertices.resize(nv);
+  m.vertex_restitution.resize(nv);
+  m.vertex_friction.resize(nv);
+  double reach = 0.0;
+  for (std::size_t c = 0; c < nv; ++c) {
+    m.vertices[c] = m.geo_to_body * (shape.vertices[c] - mp.com);
     m.vertex_restitution[c] = scene.floor.restitution ? *scene.floor.restitution : body.vertex_restitution[c];
     m.vertex_friction[c] = body.vertex_friction[c];
-    m.bounding_radius = std::max(m.bounding_radius, m.vertices[c].norm());
+    reach = std::max(reach, m.vertices[c].norm());
   }
-  for (int f = 0; f < 6; ++f) {
-    m.face_normals[f] = m.geo_to_body * body.shape.normals[f];
-    m.face_labels[f] = body.face_labels[f];
-  }
+  m.bounding_radius = reach + m.rounding;
+  m.face_normals.resize(nf);
+  m.face_labels = body.face_labels;
+  for (std::size_t f = 0; f < nf; ++f) m.face_normals[f] = m.geo_to_body * shape.normals[f];
+  build_topology(m, shape, origin, body.kind);
+  build_outcomes(m);
 
   compute_rest_geometry(m);
   m.max_friction = *std::max_element(m.vertex_friction.begin(), m.vertex_friction.end());
@@ -67,7 +165,7 @@ DieModel compile(const SceneDef& scene, const std::string& origin) {
     const Vec3 e = scene.throw_.orientation.euler_deg * (kPi / 180.0);
     const Mat3 R = euler_zxz(e.x(), e.y(), e.z()) * m.geo_to_body.transpose();
     double depth = 0.0;
-    for (const Vec3& v : m.vertices) depth = std::max(depth, -(R * v).z());
+    for (const Vec3& v : m.vertices) depth = std::max(depth, -(R * v).z() + m.rounding);
     if (h.mean < depth - 1e-12 * m.bounding_radius)
       throw SceneError(origin, "throw.height.mean", fmt(h.mean),
                        "the die starts below the floor: in this orientation the COM must be at least " +

@@ -17,9 +17,9 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
   bool sustained = false;
   bool after_impact = false;  // the state is right after an impact (sustained contact is possible)
   const auto settle = [&](int down) {
+    if (probe && probe->final_state) *probe->final_state = s;
     r.status = TossStatus::Settled;
-    r.face_index = opposite_face(down);
-    r.face = m.face_labels[r.face_index];
+    set_result_face(m, result_face(m, down), r);
     r.t_end = t;
     return r;
   };
@@ -66,6 +66,7 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
   }
   r.status = TossStatus::Unresolved;
   r.t_end = t;
+  if (probe && probe->final_state) *probe->final_state = s;
   return r;
 }
 

@@ -12,6 +12,7 @@ TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossPro
   const StepperOutcome o = run_fixed_steps(m, s, t, impacts, m.step, tiebreak, /*allow_liftoff=*/false,
                                            ImpactThreshold::Contact);
   if (probe) probe->flights += 1;
+  if (probe && probe->final_state) *probe->final_state = s;
   r.bounces = impacts;
   r.t_end = t;
   if (o.exit != StepperExit::Settled) {
@@ -19,8 +20,7 @@ TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossPro
     return r;
   }
   r.status = TossStatus::Settled;
-  r.face_index = opposite_face(o.face_down);
-  r.face = m.face_labels[r.face_index];
+  set_result_face(m, result_face(m, o.face_down), r);
   return r;
 }
 

@@ -19,11 +19,19 @@ const char* to_string(TossStatus s);
 
 struct TossResult {
   int face = 0;        // face label (settled tosses), else 0
-  int face_index = -1; // 0..5 in +x, -x, +y, -y, +z, -z order, else -1
+  int face_index = -1; // the face read, in the model's face order (a box: +x, -x, +y, -y, +z, -z), else -1
+  int outcome = -1;    // index of `face` in the model's outcome_labels (label order), else -1
   TossStatus status = TossStatus::Invalid;
   int bounces = 0;
   double t_end = 0.0;  // simulated time at the end (s)
 };
+
+// Records face index f as the result read (label and outcome from the model).
+inline void set_result_face(const DieModel& m, int f, TossResult& r) {
+  r.face_index = f;
+  r.face = m.face_labels[static_cast<std::size_t>(f)];
+  r.outcome = m.face_outcome[static_cast<std::size_t>(f)];
+}
 
 // One impact, for traces and replays.
 struct BounceRecord {
@@ -43,6 +51,7 @@ struct TossProbe {
   double impact_s = 0.0;                       // impulses and the stop rule
   std::uint64_t search_iterations = 0;         // conservative-advancement steps
   std::uint64_t flights = 0;
+  RigidState* final_state = nullptr;           // impulse, stepped: the state when the toss ended
 };
 
 // Chatter guard (`paper`): this many impacts in a row, each less than kZenoInterval after the
