@@ -10,20 +10,107 @@
 namespace dicesim::agg {
 
 Aggregator::Aggregator(AggregatorConfig cfg, Send send)
-    : cfg_(std::move(cfg)), send_(std::move(send)), limit_(cfg_.spec.total) {
+    : cfg_(std::move(cfg)), send_(std::move(send)), limit_(cfg_.spec.total), sealer_(cfg_.key) {
   for (std::size_t i = 0; i < 6; ++i)
     if (cfg_.labels[i] >= 1 && cfg_.labels[i] <= 6) label_to_index_[static_cast<std::size_t>(cfg_.labels[i])] =
         static_cast<std::int8_t>(i + 1);
 }
 
+namespace {
+// Lease ids of a resumed run start this far above the checkpoint's: the dead aggregator may have
+// granted more after its last checkpoint (a few hundred a second at most), and a worker ignores
+// a lease id it has already finished or holds.
+constexpr std::int64_t kResumeLeaseGap = 1'000'000;
+}  // namespace
+
+Aggregator::Aggregator(AggregatorConfig cfg, Send send, const Checkpoint& from, double now)
+    : Aggregator(std::move(cfg), std::move(send)) {
+  limit_ = std::min<std::uint64_t>(from.limit, cfg_.spec.total);
+  for (const auto& [lo, hi] : from.received) received_.add(lo, hi);
+  frontier_ = from.frontier;
+  next_lease_ = from.next_lease + kResumeLeaseGap;
+  prefix_ = from.prefix;
+  prefix_end_ = from.prefix_end;
+  all_ = from.all;
+  blocks_ = from.blocks;
+  const HealthCounts& h = from.health;
+  health_.batches = h.batches, health_.duplicates = h.duplicates, health_.foreign = h.foreign;
+  health_.malformed = h.malformed, health_.range = h.range, health_.released = h.released, health_.leases = h.leases;
+  health_.messages_out = h.messages_out, health_.messages_in = h.messages_in, health_.unauthenticated = h.unauthenticated;
+  resumes_ = from.resumes + 1;
+  // Leases out at the checkpoint: their workers probably still work on them. Kept as if just
+  // granted; a worker that does not report within worker_timeout_s loses them (tick).
+  IntervalSet covered;
+  for (const Checkpoint::Lease& cl : from.leases) {
+    if (cl.count == 0 || cl.first >= limit_) continue;
+    Lease l;
+    l.id = cl.id, l.worker = cl.worker, l.first = cl.first, l.count = cl.count;
+    l.granted = now;
+    l.deadline = now + 3.0 * static_cast<double>(2 * cfg_.max_lease) / 500.0 + 2.0 * cfg_.worker_timeout_s;
+    leases_[l.id] = l;
+    covered.add(l.first, std::min(limit_, l.first + l.count));
+    Worker& w = workers_[l.worker];
+    w.last_seen = now;  // not ready until it reports: no new lease before that
+  }
+  // Below the frontier, what is neither held nor under a restored lease was lost with the old
+  // aggregator (results after its last checkpoint, leases granted after it): lease it again.
+  for (const IntervalSet::Range& g : received_.gaps(0, std::min(frontier_, limit_)))
+    for (const IntervalSet::Range& r : covered.gaps(g.first, g.second)) {
+      const std::uint64_t n = requeue_.add(r.first, r.second);
+      health_.released += n;
+      resume_.requeued += n;
+    }
+  resume_.resumed = true;
+  resume_.held = received_.size();
+  resume_.leases = leases_.size();
+  resume_.resumes = resumes_;
+  resume_.age_s = std::max(0.0, static_cast<double>(wire::now_utime() - from.written_utime) * 1e-6);
+  rate_n_ = received_.size();
+  advance_prefix();  // a checkpoint of a finished run is finished at once
+}
+
+Checkpoint Aggregator::checkpoint(double elapsed_s) const {
+  Checkpoint c;
+  c.start = wire::to_message(cfg_.spec);
+  c.labels = cfg_.labels;
+  c.target_halfwidth = cfg_.target_halfwidth;
+  c.limit = limit_;
+  for (const auto& [lo, hi] : received_.ranges_list()) c.received.emplace_back(lo, hi);
+  c.frontier = frontier_;
+  c.next_lease = next_lease_;
+  c.prefix_end = prefix_end_;
+  c.prefix = prefix_;
+  c.all = all_;
+  c.blocks = blocks_;
+  for (const auto& [id, l] : leases_)
+    if (l.done_at < 0) c.leases.push_back({l.id, l.worker, l.first, l.count});
+  const Health& h = health_;
+  c.health = {h.batches, h.duplicates, h.foreign, h.malformed, h.range, h.released, h.leases, h.messages_out, h.messages_in,
+              h.unauthenticated};
+  c.elapsed_s = elapsed_s;
+  c.written_utime = wire::now_utime();
+  c.finished = finished_;
+  c.resumes = resumes_;
+  return c;
+}
+
 template <class T>
 void Aggregator::publish(const char* channel, const T& msg) {
   ++health_.messages_out;
-  send_(channel, wire::encode(msg));
+  std::vector<std::uint8_t> bytes = wire::encode(msg);
+  sealer_.seal(channel, bytes);
+  send_(channel, bytes);
 }
 
 void Aggregator::on_message(std::string_view channel, const void* data, std::size_t len, double now) {
   ++health_.messages_in;
+  // Authentication first, on the raw bytes: nothing unauthenticated is even decoded.
+  if (const auto payload = sealer_.open(channel, data, len)) {
+    len = *payload;
+  } else {
+    ++health_.unauthenticated;
+    return;
+  }
   if (channel == wire::kTossBatch) {
     if (auto b = wire::decode<dicesim_lcm::toss_batch>(data, len)) return on_batch(*b, now);
     ++health_.malformed;
@@ -345,6 +432,7 @@ dicesim_lcm::probabilities Aggregator::snapshot() const {
   m.corrections[1] = static_cast<std::int64_t>(c.corrections.pgs_unconverged);
   m.corrections[2] = static_cast<std::int64_t>(c.corrections.overlap_fixes);
   m.corrections[3] = static_cast<std::int64_t>(c.corrections.fallbacks);
+  m.rejected_unauthenticated = static_cast<std::int64_t>(health_.unauthenticated);
   return m;
 }
 

@@ -16,7 +16,9 @@
 #include <string_view>
 #include <vector>
 
+#include "aggregator/checkpoint.hpp"
 #include "aggregator/interval_set.hpp"
+#include "messages/auth.hpp"
 #include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
 #include "sim/study/monte_carlo.hpp"
@@ -35,6 +37,9 @@ struct AggregatorConfig {
   double done_grace_s = 0.3;        // after a worker finished a lease, wait this long for stragglers
   double probabilities_period_s = 0.25;
   double run_start_period_s = 1.0;
+  // The run's key (messages/auth.hpp): empty, no authentication; else every message out is sealed
+  // and every message in must open, or it is dropped and counted (Health::unauthenticated).
+  std::vector<std::uint8_t> key;
 };
 
 // Why messages were ignored: the aggregator's health, published in `probabilities`.
@@ -48,12 +53,31 @@ struct Health {
   std::uint64_t leases = 0;      // leases granted
   std::uint64_t messages_out = 0;
   std::uint64_t messages_in = 0;
+  std::uint64_t unauthenticated = 0;  // with a key: no seal, or a wrong one (forged, tampered, another key)
+};
+
+// What a resumed aggregator found in its checkpoint.
+struct ResumeInfo {
+  bool resumed = false;
+  double age_s = 0.0;             // how old the checkpoint was when read
+  std::uint64_t held = 0;         // toss indices it held
+  std::uint64_t requeued = 0;     // indices below its frontier it did not hold (and no restored lease covers): leased again
+  std::size_t leases = 0;         // leases it restored (the workers still hold them)
+  int resumes = 0;                // including this one
 };
 
 class Aggregator {
  public:
   using Send = std::function<void(const char* channel, const std::vector<std::uint8_t>& bytes)>;
   Aggregator(AggregatorConfig cfg, Send send);
+  // Continues a run from a checkpoint (cfg.spec must be the checkpoint's run; the caller decodes
+  // it from Checkpoint::start). Leases the checkpoint lists are kept for the workers that still
+  // hold them; what it did not hold below its frontier is leased again. `now` is the caller's clock.
+  Aggregator(AggregatorConfig cfg, Send send, const Checkpoint& from, double now);
+
+  // The state to write to disk (checkpoint.hpp); `elapsed_s`: run time so far, this session included.
+  Checkpoint checkpoint(double elapsed_s) const;
+  const ResumeInfo& resume_info() const { return resume_; }
 
   // One received message on `channel`; never throws, whatever the bytes.
   void on_message(std::string_view channel, const void* data, std::size_t len, double now);
@@ -118,6 +142,9 @@ class Aggregator {
   RunCounts all_;
 
   Health health_;
+  ResumeInfo resume_;
+  int resumes_ = 0;
+  wire::Sealer sealer_;
   std::vector<std::string> refusals_;
   std::map<std::int64_t, bool> refused_;
   bool finished_ = false;

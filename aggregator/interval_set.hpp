@@ -46,6 +46,7 @@ class IntervalSet {
   bool empty() const { return ranges_.empty(); }
   std::size_t ranges() const { return ranges_.size(); }
   Range first() const { return *ranges_.begin(); }  // precondition: !empty()
+  const std::map<std::uint64_t, std::uint64_t>& ranges_list() const { return ranges_; }  // lo -> hi, in order
 
  private:
   void insert(std::uint64_t lo, std::uint64_t hi);

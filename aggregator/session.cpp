@@ -1,5 +1,6 @@
 #include "aggregator/session.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 
@@ -27,7 +28,8 @@ std::string health_line(const Health& h) {
   return "batches " + std::to_string(h.batches) + ", duplicates " + std::to_string(h.duplicates) +
          ", rejected: foreign " + std::to_string(h.foreign) + ", malformed " + std::to_string(h.malformed) +
          ", out of range " + std::to_string(h.range) + "; re-leased " + std::to_string(h.released) +
-         " tosses; messages in " + std::to_string(h.messages_in) + ", out " + std::to_string(h.messages_out);
+         " tosses; messages in " + std::to_string(h.messages_in) + ", out " + std::to_string(h.messages_out) +
+         ", unauthenticated " + std::to_string(h.unauthenticated);
 }
 
 SessionResult run_session(const SessionOptions& opt, const AggregatorConfig& cfg) {
@@ -38,9 +40,25 @@ SessionResult run_session(const SessionOptions& opt, const AggregatorConfig& cfg
     return res;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  Aggregator agg(cfg, [&bus](const char* channel, const std::vector<std::uint8_t>& bytes) {
+  auto send = [&bus](const char* channel, const std::vector<std::uint8_t>& bytes) {
     bus.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
-  });
+  };
+  Aggregator agg = opt.resume ? Aggregator(cfg, send, *opt.resume, 0.0) : Aggregator(cfg, send);
+  const double elapsed_before = opt.resume ? opt.resume->elapsed_s : 0.0;
+  std::unique_ptr<CheckpointWriter> writer;
+  if (!opt.checkpoint_path.empty()) writer = std::make_unique<CheckpointWriter>(opt.checkpoint_path);
+  double last_checkpoint = -1e9;
+  auto take_checkpoint = [&](double now) {
+    const auto s0 = std::chrono::steady_clock::now();
+    std::string text = to_json(agg.checkpoint(elapsed_before + now));
+    const double s = seconds_since(s0);
+    ++res.snapshots;
+    res.snapshot_s += s;
+    res.max_snapshot_s = std::max(res.max_snapshot_s, s);
+    writer->submit(std::move(text));
+    last_checkpoint = now;
+  };
+  if (opt.on_start) opt.on_start(agg);
   Inbox inbox{&agg, t0};
   for (const char* ch : {wire::kTossBatch, wire::kWorkerStatus, wire::kRunStart, wire::kWorkLease,
                          wire::kProbabilities, wire::kBounceState}) {
@@ -61,6 +79,7 @@ SessionResult run_session(const SessionOptions& opt, const AggregatorConfig& cfg
     if (now - last_tick >= 0.02) {
       last_tick = now;
       agg.tick(now);
+      if (writer && now - last_checkpoint >= opt.checkpoint_period_s) take_checkpoint(now);
       if (opt.on_tick) {
         if (std::string why = opt.on_tick(agg); !why.empty()) {
           res.error = why;
@@ -74,6 +93,13 @@ SessionResult run_session(const SessionOptions& opt, const AggregatorConfig& cfg
     }
   }
   res.elapsed_s = seconds_since(t0);
+  res.run_elapsed_s = elapsed_before + res.elapsed_s;
+  if (writer) {
+    // The last state (finished, interrupted or failed), so that --resume continues from here.
+    take_checkpoint(res.elapsed_s);
+    writer->flush();
+    res.writer = writer->stats();
+  }
   res.counts = agg.result();
   res.tosses = agg.stop();
   res.health = agg.health();

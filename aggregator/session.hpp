@@ -18,6 +18,11 @@ struct SessionOptions {
   // Called about every 20 ms; return a non-empty message to abort the run as failed.
   std::function<std::string(const Aggregator&)> on_tick;
   int queue_capacity = 4096;                    // per subscription (LCM 1.3.1's default is 30)
+  std::string checkpoint_path;                  // non-empty: write the state there (checkpoint.hpp)
+  double checkpoint_period_s = 1.0;             // at most this often (and once at the end)
+  const Checkpoint* resume = nullptr;           // continue this run instead of starting it
+  // Called once the aggregator exists (e.g. to log what a resume found).
+  std::function<void(const Aggregator&)> on_start;
 };
 
 enum class SessionEnd { Finished, Cancelled, Failed };
@@ -30,6 +35,12 @@ struct SessionResult {
   std::uint64_t tosses = 0;
   Health health;
   std::vector<std::string> refusals;
+  double run_elapsed_s = 0.0;         // over every session of the run (resumes included)
+  // Checkpoint cost: the aggregator's own loop pays snapshot_s (taking and serialising the
+  // state); the writer thread spends writer.write_s in write + fsync + rename + fsync.
+  std::uint64_t snapshots = 0;
+  double snapshot_s = 0.0, max_snapshot_s = 0.0;
+  CheckpointWriter::Stats writer;
 };
 
 SessionResult run_session(const SessionOptions& opt, const AggregatorConfig& cfg);

@@ -13,4 +13,19 @@ double max_halfwidth(const RunCounts& c) {
   return w;
 }
 
+RunCounts run_to_target(const DieModel& model, RunConfig cfg, std::uint64_t cap, double h, std::uint64_t& done) {
+  RunCounts total;
+  const auto progress = cfg.progress;
+  const auto cancelled = [&cfg] { return cfg.cancel && cfg.cancel->load(); };
+  for (done = 0; done < cap && !halfwidth_reached(total, h) && !cancelled();) {
+    cfg.first = done;
+    cfg.tosses = std::min(kTargetBlock, cap - done);
+    const std::uint64_t base = done;
+    if (progress) cfg.progress = [&](std::uint64_t d, std::uint64_t) { progress(base + d, cap); };
+    total.merge(run_tosses(model, cfg));
+    done += cfg.tosses;
+  }
+  return total;
+}
+
 }  // namespace dicesim::agg

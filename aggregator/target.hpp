@@ -16,4 +16,10 @@ inline constexpr std::uint64_t kTargetBlock = 10000;
 double max_halfwidth(const RunCounts& c);
 inline bool halfwidth_reached(const RunCounts& c, double h) { return c.settled > 0 && max_halfwidth(c) <= h; }
 
+// In this process (`toss --target-halfwidth`, the Python module): blocks of kTargetBlock in index
+// order from cfg.first = 0, stopping at the first block boundary where halfwidth_reached(h), after
+// `cap` tosses, or when cfg.cancel is set. `done` receives the tosses taken; cfg.progress (if any)
+// sees (done, cap) over the whole run.
+RunCounts run_to_target(const DieModel& model, RunConfig cfg, std::uint64_t cap, double h, std::uint64_t& done);
+
 }  // namespace dicesim::agg

@@ -2,10 +2,19 @@
 #include <exception>
 #include <string_view>
 
+#include "aggregator/checkpoint.hpp"
 #include "apps/commands.hpp"
+#include "messages/auth.hpp"
 #include "sim/scene/scene_error.hpp"
 
 namespace dicesim {
+
+void require_six_outcomes(const DieModel& m, const std::string& scene_path) {
+  if (m.outcomes() == 6) return;
+  throw SceneError(scene_path, "die.shape", m.kind,
+                   "distributed runs (run, aggregate, sweep --workers) carry six outcomes on the wire for now; "
+                   "this die has " + std::to_string(m.outcomes()) + ": use `dicesim toss`");
+}
 
 void SceneArgs::add_to(CLI::App* cmd) {
   cmd->add_option("SCENE", path, "Scene file (TOML), e.g. scenes/paper/die1.toml")->required();
@@ -23,6 +32,19 @@ SceneDef SceneArgs::load() const {
   return load_scene(path, all);
 }
 
+CLI::Option* add_key_file_option(CLI::App* cmd, std::string& path) {
+  return cmd->add_option("--key-file", path,
+                         "Authenticated run: seal every message sent with HMAC-SHA-256 under the key in FILE, and\n"
+                         "drop (and count) every message received without a valid seal. Every process of the run\n"
+                         "needs the same file: hex digits, at least 64 (32 bytes), mode 0600 or 0400, owned by\n"
+                         "you or root. Make one: (umask 077; openssl rand -hex 32 > run.key). README, Security")
+      ->type_name("FILE");
+}
+
+std::vector<std::uint8_t> load_run_key(const std::string& path) {
+  return path.empty() ? std::vector<std::uint8_t>{} : wire::load_key_file(path);
+}
+
 int parse_and_run(CLI::App& app, int argc, char** argv, const int& exit_code) {
   add_log_options(app, argc, argv);
   try {
@@ -35,6 +57,12 @@ int parse_and_run(CLI::App& app, int argc, char** argv, const int& exit_code) {
     std::fprintf(stderr, "%s: %s\nRun with --help for usage.\n", app.get_name().c_str(), e.what());
     return kExitBadInput;
   } catch (const SceneError& e) {
+    std::fprintf(stderr, "dicesim: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const wire::KeyError& e) {
+    std::fprintf(stderr, "dicesim: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const agg::CheckpointError& e) {
     std::fprintf(stderr, "dicesim: error: %s\n", e.what());
     return kExitBadInput;
   } catch (const std::exception& e) {

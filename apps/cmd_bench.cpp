@@ -54,6 +54,9 @@ int run_bench(const BenchArgs& a) {
   const nlohmann::json j = {
       {"scene", a.scene.path},
       {"fidelity", to_string(m.fidelity)},
+      {"shape", m.kind},
+      {"faces", m.face_count()},
+      {"vertices", m.vertex_count()},
       {"tosses", a.tosses},
       {"tosses_per_s_1_thread", rate1},
       {"threads", a.threads},
@@ -67,8 +70,8 @@ int run_bench(const BenchArgs& a) {
   if (a.json) {
     std::printf("%s\n", j.dump().c_str());
   } else {
-    std::printf("%s  (fidelity %s, %llu tosses)\n", a.scene.path.c_str(), to_string(m.fidelity),
-                static_cast<unsigned long long>(a.tosses));
+    std::printf("%s  (fidelity %s, %s: %d corners, %d faces; %llu tosses)\n", a.scene.path.c_str(), to_string(m.fidelity),
+                m.kind.c_str(), m.vertex_count(), m.face_count(), static_cast<unsigned long long>(a.tosses));
     std::printf("1 thread            %12.0f tosses/s  (%.3f us per toss)\n", rate1, 1e6 / rate1);
     std::printf("%d threads %s        %12.0f tosses/s  (scaling efficiency %.1f%%)\n", a.threads,
                 a.threads < 10 ? " " : "", raten, 100.0 * raten / (rate1 * a.threads));

@@ -22,6 +22,7 @@ struct BridgeArgs {
   std::string lcm;
   std::string dds_config;
   std::uint32_t domain = 0;
+  std::string key_file;
 };
 
 int run_bridge_command(const BridgeArgs& a) {
@@ -30,6 +31,7 @@ int run_bridge_command(const BridgeArgs& a) {
   def.lcm_url = wire::resolve_url(a.lcm);
   def.dds_domain = a.domain;
   def.stop = &g_stop;
+  def.key = load_run_key(a.key_file);  // KeyError: bad input, exit 2 (parse_and_run)
   try {
     const bridge::DdsConfigChoice cfg =
         bridge::resolve_dds_config(a.dds_config, std::getenv("CYCLONEDDS_URI"), bridge::executable_dir());
@@ -41,9 +43,10 @@ int run_bridge_command(const BridgeArgs& a) {
     const bridge::BridgeStats s = bridge::run_bridge(def);
     std::fprintf(stderr,
                  "dicesim: bridge stopped: %lld answers and %lld run statuses published from %lld runs; "
-                 "%lld malformed LCM messages ignored, %lld DDS write errors\n",
+                 "%lld malformed and %lld unauthenticated LCM messages ignored, %lld DDS write errors\n",
                  static_cast<long long>(s.answers), static_cast<long long>(s.statuses), static_cast<long long>(s.runs),
-                 static_cast<long long>(s.malformed), static_cast<long long>(s.write_errors));
+                 static_cast<long long>(s.malformed), static_cast<long long>(s.unauthenticated),
+                 static_cast<long long>(s.write_errors));
     return s.write_errors == 0 ? kExitOk : kExitFailed;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dicesim: bridge failed: %s\n", e.what());
@@ -74,6 +77,10 @@ void register_bridge(CLI::App& app, int& exit_code) {
   cmd->add_option("--dds-config", args->dds_config, "Cyclone DDS configuration file (default: see above)")
       ->type_name("FILE")
       ->check(CLI::ExistingFile);  // a missing file is bad input (exit 2), caught before anything opens
+  add_key_file_option(cmd, args->key_file)
+      ->description("Bridge only an authenticated run's messages: those whose HMAC-SHA-256 seal opens with the key\n"
+                    "in FILE (others are dropped and counted). DDS itself is not authenticated by this: secure the\n"
+                    "DDS side with DDS Security or a trusted network. README, Security");
   cmd->add_option("--dds-domain", args->domain, "DDS domain id")->capture_default_str()->check(CLI::Range(0, 230));
   cmd->callback([args, &exit_code] { exit_code = run_bridge_command(*args); });
 }

@@ -1,62 +1,28 @@
 // dicesim info: what the scene compiles to: mass properties, principal frame, faces, corners.
+#include <cmath>
 #include <cstdio>
-
-#include <nlohmann/json.hpp>
+#include <vector>
 
 #include "apps/commands.hpp"
+#include "apps/info_json.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/models/compile.hpp"
+#include "sim/models/fidelity_models.hpp"
 
 namespace dicesim {
 namespace {
 
-nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
-nlohmann::json mat(const Mat3& m) { return {vec(m.row(0)), vec(m.row(1)), vec(m.row(2))}; }
-
-// Resting geometry: per face, the COM height on it and the lowest pass over its edges.
-nlohmann::json rest_json(const DieModel& m) {
-  nlohmann::json faces = nlohmann::json::array();
-  for (int f = 0; f < 6; ++f)
-    faces.push_back({{"label", m.face_labels[f]}, {"height", m.face_height[f]}, {"escape_height", m.face_escape[f]},
-                     {"tip_ratio", m.face_tip_ratio[f]}});
-  return faces;
-}
-
-nlohmann::json info_json(const std::string& path, const DieModel& m) {
-  const MassProperties& mp = m.mass_geometric;
-  nlohmann::json faces = nlohmann::json::array();
-  for (int f = 0; f < 6; ++f) {
-    Vec3 n = Vec3::Zero();
-    n[f / 2] = (f % 2 == 0) ? 1.0 : -1.0;
-    faces.push_back({{"label", m.face_labels[f]}, {"direction", kFaceDirNames[f]}, {"normal", vec(n)}});
-  }
-  nlohmann::json corners = nlohmann::json::array();
-  for (int c = 0; c < 8; ++c) {
-    const Vec3 geo = m.geo_to_body.transpose() * m.vertices[c] + mp.com;
-    corners.push_back({{"position", vec(geo)}, {"restitution", m.vertex_restitution[c]}, {"friction", m.vertex_friction[c]}});
-  }
-  return {{"scene", path},
-          {"name", m.name},
-          {"mass", mp.mass},
-          {"com", vec(mp.com)},
-          {"inertia", mat(mp.inertia)},
-          {"principal_moments", vec(mp.principal_moments)},
-          {"principal_axes", mat(mp.principal_axes)},
-          {"symmetric_top", m.symmetric_top},
-          {"bounding_radius", m.bounding_radius},
-          {"faces", faces},
-          {"corners", corners},
-          {"fidelity", to_string(m.fidelity)},
-          {"fidelity_requested", to_string(m.fidelity_requested)},
-          {"fidelity_reason", m.fidelity_reason},
-          {"rest", rest_json(m)}};
-}
+Vec3 geometric_normal(const DieModel& m, std::size_t f) { return m.geo_to_body.transpose() * m.face_normals[f]; }
 
 void print_info(const std::string& path, const DieModel& m) {
   const MassProperties& mp = m.mass_geometric;
   std::printf("%s%s%s\n\n", path.c_str(), m.name.empty() ? "" : ": ", m.name.c_str());
+  std::printf("shape              %s: %d corners, %d faces, %d outcomes, read %s%s\n", m.kind.c_str(), m.vertex_count(),
+              m.face_count(), m.outcomes(), m.read_down ? "down (the face on the floor)" : "up",
+              m.convex ? "" : "  (not convex: contact uses its hull)");
+  if (m.rounding > 0.0) std::printf("rounding           %.6g m (edges and corners)\n", m.rounding);
   std::printf("mass               %.9g kg\n", mp.mass);
-  std::printf("centre of mass     (%+.6e, %+.6e, %+.6e) m from the box centre (%.4f mm off)\n", mp.com.x(), mp.com.y(),
+  std::printf("centre of mass     (%+.6e, %+.6e, %+.6e) m from the geometric centre (%.4f mm off)\n", mp.com.x(), mp.com.y(),
               mp.com.z(), 1e3 * mp.com.norm());
   std::printf("inertia about COM  [%+.6e %+.6e %+.6e]\n", mp.inertia(0, 0), mp.inertia(0, 1), mp.inertia(0, 2));
   std::printf("  (kg m^2,         [%+.6e %+.6e %+.6e]\n", mp.inertia(1, 0), mp.inertia(1, 1), mp.inertia(1, 2));
@@ -66,15 +32,27 @@ void print_info(const std::string& path, const DieModel& m) {
   for (int k = 0; k < 3; ++k)
     std::printf("  axis %d           (%+.4f, %+.4f, %+.4f)\n", k + 1, mp.principal_axes(0, k), mp.principal_axes(1, k),
                 mp.principal_axes(2, k));
-  std::printf("bounding radius    %.6g m (COM to farthest corner)\n\nfaces (label: outward normal)\n", m.bounding_radius);
-  for (int f = 0; f < 6; ++f) std::printf("  %d: %s\n", m.face_labels[f], kFaceDirNames[f]);
+  std::printf("bounding radius    %.6g m (COM to farthest point)\n\n", m.bounding_radius);
+  const std::vector<double> p_static = static_face_probabilities(m, kInfoStaticDirections);
+  std::printf("faces (outward normal in the geometric frame; area of the flat face; can it hold the die;\n"
+              "p_static: probability of reading it in `static` with a uniform orientation; COM height resting on it;\n"
+              "lowest COM height out of its basin)\n");
+  std::printf("  face  label  normal                          area (m^2)    stable  p_static   height (m)   escape (m)\n");
+  for (std::size_t f = 0; f < m.face_normals.size(); ++f) {
+    const Vec3 n = geometric_normal(m, f);
+    std::printf("  %4zu  %5d  (%+.4f, %+.4f, %+.4f)  %.6e  %-6s  %.5f    %.6g", f, m.face_labels[f], n.x(), n.y(), n.z(),
+                m.face_area[f], m.face_hold[f] >= 0.0 ? "yes" : "no", p_static[f], m.face_height[f]);
+    if (std::isfinite(m.face_escape[f]))
+      std::printf("   %.6g\n", m.face_escape[f]);
+    else
+      std::printf("   %s\n", m.face_hold[f] >= 0.0 ? "none (the only basin)" : "-");
+  }
   std::printf("\ncorners (restitution, friction: volume mix of the materials at the corner)\n");
-  for (int c = 0; c < 8; ++c)
-    std::printf("  (%c,%c,%c)  e = %.4f  mu = %.3f\n", (c & 1) ? '+' : '-', (c & 2) ? '+' : '-', (c & 4) ? '+' : '-',
+  for (std::size_t c = 0; c < m.vertices.size(); ++c) {
+    const Vec3 geo = m.geo_to_body.transpose() * m.vertices[c] + mp.com;
+    std::printf("  %4zu  (%+.6f, %+.6f, %+.6f)  e = %.4f  mu = %.3f\n", c, geo.x(), geo.y(), geo.z(),
                 m.vertex_restitution[c], m.vertex_friction[c]);
-  std::printf("\nresting (COM height on the face; lowest COM height over its edges)\n");
-  for (int f = 0; f < 6; ++f)
-    std::printf("  %d: %.6g m, escape %.6g m\n", m.face_labels[f], m.face_height[f], m.face_escape[f]);
+  }
   std::printf("\nfidelity           %s", to_string(m.fidelity));
   if (m.fidelity_requested == Fidelity::Auto) std::printf(" (chosen by auto)");
   std::printf("\n  why              %s\n", m.fidelity_reason.c_str());
@@ -91,10 +69,12 @@ void register_info(CLI::App& app, int& exit_code) {
   CLI::App* cmd = app.add_subcommand(
       "info",
       "Compile a scene and print the die's exact mass, centre of mass, inertia tensor about the\n"
-      "COM (products of inertia included), principal moments and axes, and the face map.\n\n"
+      "COM (products of inertia included), principal moments and axes, and per face its label,\n"
+      "outward normal, area, whether the die can rest on it and its `static` probability.\n\n"
       "Example:  dicesim info scenes/paper/die3.toml --json");
   args->scene.add_to(cmd);
-  cmd->add_flag("--json", args->json, "One JSON object: mass, com, inertia (3x3), principal_moments, ...");
+  cmd->add_flag("--json", args->json, "One JSON object: shape, vertex_count, face_count, faces [{label, normal, area, stable,\n"
+                "p_static}], mass, com, inertia (3x3), principal_moments, ...");
   cmd->callback([args, &exit_code] {
     const DieModel m = compile(args->scene.load(), args->scene.path);
     if (args->json)

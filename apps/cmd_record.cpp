@@ -23,6 +23,7 @@ struct RecordArgs {
   bool until_done = false;
   std::int64_t run = 0;
   double timeout_s = 0.0;
+  std::string key_file;
 };
 
 int run_record(const RecordArgs& a) {
@@ -36,6 +37,7 @@ int run_record(const RecordArgs& a) {
   opt.run_id = a.run;
   opt.timeout_s = a.timeout_s;
   opt.cancel = &g_stop;
+  opt.key = load_run_key(a.key_file);
   if (a.run != 0) logging::set_run_id(a.run);
   // User-facing, not a log line: scripts wait for it before they start the run.
   opt.on_ready = [&] {
@@ -51,6 +53,10 @@ int run_record(const RecordArgs& a) {
   }
   spdlog::info("recorded {} events ({:.1f} MB) in {:.1f} s to {}", res.events, static_cast<double>(res.bytes) / 1e6,
                res.elapsed_s, a.out);
+  if (res.unauthenticated > 0)
+    spdlog::warn("{} run_start/probabilities messages failed the HMAC check (recorded as heard; replay --key-file "
+                 "drops them)",
+                 res.unauthenticated);
   switch (res.end) {
     case eventlog::RecordEnd::Done:
     case eventlog::RecordEnd::Stopped: return kExitOk;
@@ -92,6 +98,10 @@ void register_record(CLI::App& app, int& exit_code) {
                   "Stop after S seconds (with --until-done: fail, exit 1, if the run has not finished by then)")
       ->type_name("S")
       ->check(CLI::Range(0.0, 1e9));
+  add_key_file_option(cmd, args->key_file)
+      ->description("An authenticated run: messages are recorded as heard, seals included, but only those whose\n"
+                    "HMAC-SHA-256 seal opens with the key in FILE tell the recorder which run it is and when it\n"
+                    "ends (--until-done). Replay the log with `dicesim replay --key-file FILE`");
   cmd->add_option("--channels", args->channels, "LCM channel regular expression to record")->capture_default_str();
   cmd->callback([args, &exit_code] { exit_code = run_record(*args); });
 }

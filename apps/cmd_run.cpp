@@ -24,7 +24,9 @@ struct RunArgs {
 };
 
 int run_run(const RunArgs& a) {
-  (void)compile(a.agg.scene.load(), a.agg.scene.path);  // bad input: exit 2 before any child starts
+  // Bad input (scene or key file): exit 2 before any child starts.
+  require_six_outcomes(compile(a.agg.scene.load(), a.agg.scene.path), a.agg.scene.path);
+  (void)load_run_key(a.agg.key_file);
   const std::int64_t run_id = wire::new_run_id();
   // --lcm or $LCM_DEFAULT_URL if given; else the host-confined group on a port of this run's own.
   std::string url = wire::resolve_url(a.agg.lcm);
@@ -35,7 +37,7 @@ int run_run(const RunArgs& a) {
   std::signal(SIGTERM, on_stop_signal);
   WorkerProcesses children;
   for (int k = 0; k < a.workers; ++k)
-    if (!children.spawn(url, run_id)) {
+    if (!children.spawn(url, run_id, a.agg.key_file)) {
       std::fprintf(stderr, "dicesim: failed: cannot start worker %d\n", k + 1);
       return kExitFailed;
     }
@@ -62,8 +64,14 @@ void register_run(CLI::App& app, int& exit_code) {
       "Examples:\n"
       "  dicesim run scenes/paper/die1.toml --workers 2 --tosses 1000000\n"
       "  dicesim run scenes/paper/die3.toml --workers 4 --target-halfwidth 0.001 --json\n"
-      "  dicesim run scenes/fair.toml --workers 2 --trace-every 500   # bounce states for lcm-spy");
+      "  dicesim run scenes/fair.toml --workers 2 --trace-every 500 --lcm 'udpm://239.255.76.67:7667?ttl=0'  # for lcm-spy\n"
+      "  dicesim run scenes/paper/die1.toml --workers 2 --key-file run.key   # an authenticated run");
   args->agg.add_to(cmd);
+  // Unlike every other command, `run` does not default to the shared URL: see run_run.
+  cmd->get_option("--lcm")->description(
+      "LCM URL (default: $LCM_DEFAULT_URL if set, else a port of this run's own on the host-confined\n"
+      "group, udpm://239.255.76.67:PORT?ttl=0 with a random PORT in 20000-59999, so that concurrent\n"
+      "runs never meet; give --lcm to watch or record the run from outside)");
   cmd->add_option("-w,--workers", args->workers, "Worker processes (default: all cores)")
       ->capture_default_str()
       ->check(CLI::Range(1, 256));

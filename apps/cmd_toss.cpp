@@ -24,22 +24,6 @@ struct TossArgs {
   CLI::Option* tosses_opt = nullptr;
 };
 
-// --target-halfwidth: blocks of agg::kTargetBlock in index order, stopping at the first block
-// boundary where every face's half-width is <= H; the stopping point is independent of threads.
-RunCounts run_to_target(const DieModel& model, RunConfig cfg, std::uint64_t cap, double h, std::uint64_t& done) {
-  RunCounts total;
-  const auto progress = cfg.progress;
-  for (done = 0; done < cap && !agg::halfwidth_reached(total, h);) {
-    cfg.first = done;
-    cfg.tosses = std::min(agg::kTargetBlock, cap - done);
-    const std::uint64_t base = done;
-    cfg.progress = [&](std::uint64_t d, std::uint64_t) { progress(base + d, cap); };
-    total.merge(run_tosses(model, cfg));
-    done += cfg.tosses;
-  }
-  return total;
-}
-
 int run_toss(const TossArgs& a) {
   const SceneDef def = a.scene.load();
   const DieModel model = compile(def, a.scene.path);
@@ -56,7 +40,7 @@ int run_toss(const TossArgs& a) {
   const bool target = a.target_halfwidth > 0.0;
   // With a target and no explicit --tosses, N is only a generous cap.
   const std::uint64_t cap = target && a.tosses_opt->count() == 0 ? 1'000'000'000ULL : a.tosses;
-  const RunCounts counts = target ? run_to_target(model, cfg, cap, a.target_halfwidth, tosses) : run_tosses(model, cfg);
+  const RunCounts counts = target ? agg::run_to_target(model, cfg, cap, a.target_halfwidth, tosses) : run_tosses(model, cfg);
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   bar.finish();
   if (target)
@@ -71,7 +55,7 @@ int run_toss(const TossArgs& a) {
   r.threads = a.threads;
   r.tosses = tosses;
   r.counts = counts;
-  r.labels = model.face_labels;
+  set_labels(r, model);
   r.elapsed_s = elapsed;
   print_report(r, a.json);
   return kExitOk;

@@ -41,8 +41,9 @@ struct Setting {
 
 struct Row {
   Setting setting;
-  std::vector<std::int8_t> faces;  // per toss index: face index, -1 if not settled
-  std::array<std::uint64_t, 6> counts{};
+  std::vector<std::int32_t> faces;  // per toss index: outcome index, -1 if not settled
+  std::vector<std::uint64_t> counts;  // per outcome, label order
+  std::vector<int> labels;            // the model's outcome labels
   std::uint64_t settled = 0, unresolved = 0, invalid = 0;
   double seconds = 0.0;
   double tosses_per_s = 0.0;
@@ -71,7 +72,7 @@ void run_row(const SceneDef& base, const TradeoffArgs& a, Row& row) {
       pool.emplace_back([&, k] {
         for (std::uint64_t i = static_cast<std::uint64_t>(k); i < a.tosses; i += static_cast<std::uint64_t>(a.threads)) {
           const TossResult r = toss(m, a.seed, i);
-          if (r.status == TossStatus::Settled) row.faces[i] = static_cast<std::int8_t>(r.face_index);
+          if (r.status == TossStatus::Settled) row.faces[i] = r.outcome;
           ++status[static_cast<std::size_t>(k)][static_cast<int>(r.status)];
         }
       });
@@ -83,7 +84,9 @@ void run_row(const SceneDef& base, const TradeoffArgs& a, Row& row) {
     row.unresolved += s[1];
     row.invalid += s[2];
   }
-  for (std::int8_t f : row.faces)
+  row.labels = m.outcome_labels;
+  row.counts.assign(m.outcome_labels.size(), 0);
+  for (std::int32_t f : row.faces)
     if (f >= 0) ++row.counts[static_cast<std::size_t>(f)];
 }
 
@@ -153,8 +156,8 @@ int run_tradeoff(const TradeoffArgs& a) {
 
   const auto row_json = [&](const Row& r) {
     nlohmann::json p = nlohmann::json::object();
-    for (int f = 0; f < 6; ++f)
-      p[std::to_string(base.die.face_labels[f])] = r.settled ? static_cast<double>(r.counts[f]) / r.settled : 0.0;
+    for (std::size_t f = 0; f < r.counts.size(); ++f)
+      p[std::to_string(r.labels[f])] = r.settled ? static_cast<double>(r.counts[f]) / r.settled : 0.0;
     return nlohmann::json{{"fidelity", to_string(r.setting.fidelity)}, {"setting", r.setting.label},
                           {"tosses_per_s", r.tosses_per_s}, {"same_face", r.same_face},
                           {"tv", r.vs_ref.tv}, {"tv_noise", r.vs_ref.tv_noise}, {"chi2_p", r.vs_ref.chi2_p},

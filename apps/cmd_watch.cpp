@@ -9,6 +9,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "apps/commands.hpp"
+#include "messages/auth.hpp"
 #include "messages/wire.hpp"
 
 namespace dicesim {
@@ -22,6 +23,7 @@ struct WatchArgs {
   std::int64_t run = 0;
   bool until_finished = false;
   double timeout_s = 0.0;
+  std::string key_file;
 };
 
 // One answer as one line: progress, workers, and each face's p with its 95% half-width.
@@ -46,9 +48,12 @@ std::string answer_line(const dicesim_lcm::probabilities& m) {
 
 struct Printer {
   const WatchArgs* args;
+  wire::Sealer sealer;  // an authenticated run: only answers whose seal opens are shown
   bool finished = false;
-  void handle(const lcm::ReceiveBuffer* rb, const std::string&) {
-    const auto m = wire::decode<dicesim_lcm::probabilities>(rb->data, rb->data_size);
+  void handle(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    const auto len = sealer.open(channel, rb->data, rb->data_size);
+    if (!len) return;
+    const auto m = wire::decode<dicesim_lcm::probabilities>(rb->data, *len);
     if (!m || (args->run != 0 && m->run_id != args->run)) return;
     std::printf("%s\n", answer_line(*m).c_str());
     std::fflush(stdout);
@@ -63,7 +68,7 @@ int watch(const WatchArgs& a) {
     std::fprintf(stderr, "dicesim: failed: cannot open LCM at '%s'\n", url.c_str());
     return kExitFailed;
   }
-  Printer printer{&a};
+  Printer printer{&a, wire::Sealer(load_run_key(a.key_file))};
   bus.subscribe(wire::kProbabilities, &Printer::handle, &printer);
   std::signal(SIGINT, on_stop_signal);
   std::signal(SIGTERM, on_stop_signal);
@@ -96,6 +101,7 @@ void register_watch(CLI::App& app, int& exit_code) {
                   "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0, which never leaves this host)")
       ->type_name("URL");
   cmd->add_option("--run", args->run, "Only this run id");
+  add_key_file_option(cmd, args->key_file)->description("An authenticated run: show only answers whose HMAC-SHA-256 seal opens with the key in FILE");
   cmd->add_flag("--until-finished", args->until_finished, "Exit 0 after a run's final answer");
   cmd->add_option("--timeout", args->timeout_s, "Fail (exit 1) after this many seconds (0: never)")
       ->type_name("S")

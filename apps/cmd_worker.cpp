@@ -22,6 +22,7 @@ struct WorkerArgs {
   bool once = false;
   bool quiet = false;
   int batch = 1024;
+  std::string key_file;
 };
 
 int run_worker_cmd(const WorkerArgs& a) {
@@ -33,6 +34,7 @@ int run_worker_cmd(const WorkerArgs& a) {
   opt.cancel = &g_stop;
   opt.core.only_run = a.run;
   opt.core.batch = a.batch;
+  opt.core.key = load_run_key(a.key_file);
   // The id is chosen here, not in WorkerCore, so that every log line can carry it from the start.
   opt.core.worker_id = wire::new_run_id();
   logging::set_worker_id(opt.core.worker_id);
@@ -67,6 +69,7 @@ void register_worker(CLI::App& app, int& exit_code) {
   cmd->add_option("--batch", args->batch, "Tosses per published batch")
       ->capture_default_str()
       ->check(CLI::Range(1, wire::kMaxBatch));
+  add_key_file_option(cmd, args->key_file);
   cmd->add_flag("-q,--quiet", args->quiet, "Log the worker's events at debug level, not info (so none at the default level)");
   cmd->callback([args, &exit_code] { exit_code = run_worker_cmd(*args); });
 }

@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "sim/body/die_model.hpp"
 #include "sim/scene/scene.hpp"
 
 namespace dicesim {
@@ -24,6 +25,11 @@ struct SceneArgs {
   void add_to(CLI::App* cmd);
   SceneDef load() const;  // throws SceneError
 };
+
+// --key-file FILE (authenticated runs, messages/auth.hpp), with the same help on every command.
+CLI::Option* add_key_file_option(CLI::App* cmd, std::string& path);
+// The key in FILE, or none for an empty path. Throws wire::KeyError (bad input, exit 2).
+std::vector<std::uint8_t> load_run_key(const std::string& path);
 
 void register_toss(CLI::App& app, int& exit_code);
 void register_info(CLI::App& app, int& exit_code);
@@ -41,6 +47,10 @@ void register_watch(CLI::App& app, int& exit_code);   // cmd_watch.cpp
 void register_record(CLI::App& app, int& exit_code);  // cmd_record.cpp
 void register_replay(CLI::App& app, int& exit_code);  // cmd_replay.cpp
 
+// The LCM wire carries six outcomes until it carries N: `run`, `aggregate` and `sweep --workers`
+// refuse any other die with a SceneError (exit 2) naming the scene and the die's outcome count.
+void require_six_outcomes(const DieModel& m, const std::string& scene_path);
+
 // Distributed runs (cmd_aggregate.cpp): what `aggregate` and `run` share.
 struct AggregateArgs {
   SceneArgs scene;
@@ -52,7 +62,11 @@ struct AggregateArgs {
   double target_halfwidth = 0.0;
   double timeout_s = 0.0;
   bool json = false;
+  std::string key_file;    // --key-file: an authenticated run
+  std::string checkpoint;  // --checkpoint FILE (aggregate only)
+  std::string resume;      // --resume FILE (aggregate only): the run, from its checkpoint
   void add_to(CLI::App* cmd);
+  void add_checkpoint_options(CLI::App* cmd);  // --checkpoint, --resume; SCENE becomes optional
 };
 // Starts the run on `url`, aggregates it to the end and prints the report as `toss` does.
 // `workers` (> 0) is reported as the thread count; `on_tick` may return an error to abort.

@@ -18,13 +18,23 @@ struct FaceRow {
 
 std::vector<FaceRow> face_rows(const RunReport& r) {
   std::vector<FaceRow> rows;
-  for (std::size_t i = 0; i < 6; ++i) {
+  for (std::size_t i = 0; i < r.counts.faces.size() && i < r.labels.size(); ++i) {
     const std::uint64_t c = r.counts.faces[i];
     const double p = r.counts.settled ? static_cast<double>(c) / static_cast<double>(r.counts.settled) : 0.0;
     rows.push_back({r.labels[i], c, p, wilson_interval(c, r.counts.settled)});
   }
   std::sort(rows.begin(), rows.end(), [](const FaceRow& a, const FaceRow& b) { return a.label < b.label; });
   return rows;
+}
+
+// Against every face equally likely: outcome k expected in proportion to its number of faces.
+ChiSquare chi2_fair(const RunReport& r) {
+  if (r.faces_per_label.size() != r.counts.faces.size()) return chi2_uniform(r.counts.faces);
+  double faces = 0.0;
+  for (int k : r.faces_per_label) faces += k;
+  std::vector<double> p;
+  for (int k : r.faces_per_label) p.push_back(k / faces);
+  return chi2_against(r.counts.faces, p);
 }
 
 double rate(const RunReport& r) { return r.elapsed_s > 0.0 ? static_cast<double>(r.tosses) / r.elapsed_s : 0.0; }
@@ -35,7 +45,7 @@ nlohmann::json report_json(const RunReport& r) {
   nlohmann::json faces = nlohmann::json::array();
   for (const FaceRow& f : face_rows(r))
     faces.push_back({{"face", f.label}, {"count", f.count}, {"p", f.p}, {"ci95", {f.ci.lo, f.ci.hi}}});
-  const ChiSquare chi = chi2_uniform(r.counts.faces);
+  const ChiSquare chi = chi2_fair(r);
   return {{"scene", r.scene},
           {"fidelity", r.fidelity},
           {"seed", r.seed},
@@ -82,13 +92,19 @@ std::string report_table(const RunReport& r) {
                   static_cast<unsigned long long>(k.overlap_fixes), static_cast<unsigned long long>(k.fallbacks));
     out += line;
   }
-  const ChiSquare chi = chi2_uniform(r.counts.faces);
+  const ChiSquare chi = chi2_fair(r);
   std::snprintf(line, sizeof line, "chi-square vs a fair die: %.2f on %d dof, p = %.3g\n", chi.statistic, chi.dof, chi.p_value);
   out += line;
   std::snprintf(line, sizeof line, "%.3f s, %.0f tosses/s, %.2f impacts per toss\n", r.elapsed_s, rate(r),
                 r.tosses ? static_cast<double>(r.counts.bounces) / static_cast<double>(r.tosses) : 0.0);
   out += line;
   return out;
+}
+
+void set_labels(RunReport& r, const DieModel& m) {
+  r.labels = m.outcome_labels;
+  r.faces_per_label.assign(m.outcome_labels.size(), 0);
+  for (const int k : m.face_outcome) ++r.faces_per_label[static_cast<std::size_t>(k)];
 }
 
 void print_report(const RunReport& r, bool json) {

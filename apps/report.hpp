@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -18,15 +19,20 @@ struct RunReport {
   int threads = 1;
   std::uint64_t tosses = 0;
   RunCounts counts;
-  std::array<int, 6> labels{};  // face label per face index
+  std::vector<int> labels;          // label of each counts.faces entry (the model's outcome_labels)
+  std::vector<int> faces_per_label; // faces showing each label (empty: one each); a fair die's expectation
   double elapsed_s = 0.0;
 };
 
 // {"scene", "fidelity", "seed", "threads", "tosses", "settled", "unresolved", "invalid",
-//  "faces": [{"face", "count", "p", "ci95": [lo, hi]}], "chi2_uniform": {"statistic", "p_value"},
+//  "faces": [{"face", "count", "p", "ci95": [lo, hi]}], "chi2_uniform": {"statistic", "dof", "p_value"},
 //  "corrections": {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks"} (totals over
-//  the run; the table prints a line only when one is non-zero), "elapsed_s", "tosses_per_s"} -- p and intervals over settled tosses, faces by label.
+//  the run; the table prints a line only when one is non-zero), "elapsed_s", "tosses_per_s"} -- p and
+//  intervals over settled tosses, faces by label (N outcomes; chi-square on N - 1 dof against every
+//  face equally likely, grouped labels weighted by their faces).
 nlohmann::json report_json(const RunReport& r);
+// Fills labels and faces_per_label from the model.
+void set_labels(RunReport& r, const DieModel& m);
 std::string report_table(const RunReport& r);
 // Prints the run on stdout: one JSON object (json) or the table.
 void print_report(const RunReport& r, bool json);

@@ -12,20 +12,23 @@
 
 namespace dicesim {
 
-bool WorkerProcesses::spawn(const std::string& url, std::int64_t run_id) {
+bool WorkerProcesses::spawn(const std::string& url, std::int64_t run_id, const std::string& key_file) {
   const pid_t parent = getpid();
   const std::string run = std::to_string(run_id);
+  // Built before fork: the child only execs.
+  std::vector<std::string> args = {"dicesim", "worker", "--lcm", url, "--quiet"};
+  if (run_id != 0) args.insert(args.end(), {"--run", run, "--once"});
+  if (!key_file.empty()) args.insert(args.end(), {"--key-file", key_file});
+  std::vector<char*> argv;
+  for (std::string& s : args) argv.push_back(s.data());
+  argv.push_back(nullptr);
   const pid_t pid = fork();
   if (pid < 0) return false;
   if (pid == 0) {
     // A worker must not outlive its parent, even after a kill -9 of the parent.
     prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (getppid() != parent) _exit(1);
-    if (run_id != 0)
-      execl("/proc/self/exe", "dicesim", "worker", "--lcm", url.c_str(), "--run", run.c_str(), "--once", "--quiet",
-            static_cast<char*>(nullptr));
-    else
-      execl("/proc/self/exe", "dicesim", "worker", "--lcm", url.c_str(), "--quiet", static_cast<char*>(nullptr));
+    execv("/proc/self/exe", argv.data());
     _exit(127);
   }
   pids_.push_back(pid);

@@ -20,7 +20,8 @@ class WorkerProcesses {
 
   // Starts `dicesim worker --lcm URL --quiet`; with run_id != 0 it serves only that run and exits
   // after it (--run ID --once), with 0 it serves every run on the URL in turn.
-  bool spawn(const std::string& url, std::int64_t run_id);
+  // A non-empty key_file is passed on as --key-file (an authenticated run).
+  bool spawn(const std::string& url, std::int64_t run_id, const std::string& key_file = "");
   // Reaps exited workers (warning on stderr for abnormal exits); returns how many still run.
   int poll();
   // SIGTERM, then SIGKILL for those still running after 2 s.

@@ -11,6 +11,7 @@
 
 #include "bridge/dds_writers.hpp"
 #include "bridge/translate.hpp"
+#include "messages/auth.hpp"
 #include "messages/wire.hpp"
 
 namespace dicesim::bridge {
@@ -37,23 +38,29 @@ struct Inbox {
   BridgeStats* stats;
   std::set<std::int64_t>* seen;
   std::chrono::steady_clock::time_point t0;
+  wire::Sealer sealer;
 
   void handle(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     const double now = seconds_since(t0);
+    // With a key, only authentic messages go on (to DDS, or into the run table): the payload.
+    const auto opened = sealer.open(channel, rb->data, rb->data_size);
+    if (!opened) return void(++stats->unauthenticated);
+    const void* data = rb->data;
+    const std::size_t len = *opened;
     if (channel == wire::kProbabilities) {
-      const auto m = wire::decode<dicesim_lcm::probabilities>(rb->data, rb->data_size);
+      const auto m = wire::decode<dicesim_lcm::probabilities>(data, len);
       if (!m) return void(++stats->malformed);
       dds->write(to_dds(*m));  // first: this is the latency that matters
       ++stats->answers;
       note_run(m->run_id);
       runs->on_probabilities(*m, now);
     } else if (channel == wire::kRunStart) {
-      const auto m = wire::decode<dicesim_lcm::run_start>(rb->data, rb->data_size);
+      const auto m = wire::decode<dicesim_lcm::run_start>(data, len);
       if (!m) return void(++stats->malformed);
       note_run(m->run_id);
       runs->on_run_start(*m, now);
     } else if (channel == wire::kWorkerStatus) {
-      const auto m = wire::decode<dicesim_lcm::worker_status>(rb->data, rb->data_size);
+      const auto m = wire::decode<dicesim_lcm::worker_status>(data, len);
       if (!m) return void(++stats->malformed);
       runs->on_worker_status(*m, now);
     }
@@ -82,7 +89,7 @@ BridgeStats run_bridge(const BridgeDef& def) {
   RunTable runs(def.runs);
   std::set<std::int64_t> seen;
   const auto t0 = std::chrono::steady_clock::now();
-  Inbox inbox{&dds, &runs, &stats, &seen, t0};
+  Inbox inbox{&dds, &runs, &stats, &seen, t0, wire::Sealer(def.key)};
   for (const char* ch : {wire::kProbabilities, wire::kRunStart, wire::kWorkerStatus}) {
     lcm::Subscription* sub = bus.subscribe(ch, &Inbox::handle, &inbox);
     sub->setQueueCapacity(256);  // answers come at 4 Hz, heartbeats at 5 Hz per worker

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "bridge/run_table.hpp"
 
@@ -18,6 +19,9 @@ struct BridgeDef {
   std::uint32_t dds_domain = 0;
   const std::atomic<bool>* stop = nullptr;  // set from a signal handler: leave within ~50 ms
   RunTableDef runs = default_run_table_def();
+  // The run key (messages/auth.hpp): only messages whose HMAC seal opens are forwarded to DDS; the
+  // rest are dropped and counted (BridgeStats::unauthenticated). Empty: no authentication.
+  std::vector<std::uint8_t> key;
 };
 BridgeDef default_bridge_def();
 
@@ -27,6 +31,7 @@ struct BridgeStats {
   std::int64_t runs = 0;          // distinct runs seen
   std::int64_t malformed = 0;     // LCM messages that did not decode (ignored)
   std::int64_t write_errors = 0;  // dds_write failures
+  std::int64_t unauthenticated = 0;  // with a key: messages that failed the HMAC check (ignored)
 };
 
 // Blocks until *def.stop. Throws std::runtime_error if LCM or DDS cannot be set up.

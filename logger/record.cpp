@@ -7,6 +7,7 @@
 
 #include "logger/event_log.hpp"
 #include "logger/log.hpp"
+#include "messages/auth.hpp"
 #include "messages/wire.hpp"
 
 namespace dicesim::eventlog {
@@ -19,19 +20,32 @@ struct Recorder {
   bool write_failed = false;
   double done_at = -1.0;  // seconds since start, when the awaited run's final result came
   std::chrono::steady_clock::time_point t0;
+  wire::Sealer sealer;
+  bool told_sealed = false;
 
   void handle(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     if (!out->write(rbuf->recv_utime, channel, rbuf->data, rbuf->data_size)) write_failed = true;
+    if (channel != wire::kRunStart && channel != wire::kProbabilities) return;
     // Only two kinds are looked at: who runs, and whether the awaited run has finished.
+    const auto len = sealer.open(channel, rbuf->data, rbuf->data_size);
+    if (!len) {
+      ++res->unauthenticated;
+      return;
+    }
+    if (!sealer.enabled() && !told_sealed && wire::looks_sealed(rbuf->data, rbuf->data_size)) {
+      told_sealed = true;
+      spdlog::warn("the run's messages carry HMAC seals: they are recorded, but without --key-file this recorder "
+                   "cannot read them (nor tell when the run ends)");
+    }
     if (channel == wire::kRunStart) {
-      if (auto m = wire::decode<dicesim_lcm::run_start>(rbuf->data, rbuf->data_size))
+      if (auto m = wire::decode<dicesim_lcm::run_start>(rbuf->data, *len))
         if (m->run_id != 0 && std::find(res->runs.begin(), res->runs.end(), m->run_id) == res->runs.end()) {
           res->runs.push_back(m->run_id);
           if (logging::run_id() == 0 && (opt->run_id == 0 || opt->run_id == m->run_id)) logging::set_run_id(m->run_id);
           spdlog::info("recording run {}: {}, {} tosses, seed {}", m->run_id, m->origin, m->total_tosses, m->seed);
         }
     } else if (opt->until_done && done_at < 0 && channel == wire::kProbabilities) {
-      if (auto m = wire::decode<dicesim_lcm::probabilities>(rbuf->data, rbuf->data_size)) {
+      if (auto m = wire::decode<dicesim_lcm::probabilities>(rbuf->data, *len)) {
         const std::int64_t awaited = opt->run_id != 0 ? opt->run_id : (res->runs.empty() ? 0 : res->runs.front());
         if (m->finished == 1 && awaited != 0 && m->run_id == awaited) {
           res->done_run = awaited;
@@ -64,7 +78,7 @@ RecordResult record(const RecordOptions& opt) {
     return res;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  Recorder rec{&out, &opt, &res, false, -1.0, t0};
+  Recorder rec{&out, &opt, &res, false, -1.0, t0, wire::Sealer(opt.key)};
   lcm::Subscription* sub = bus.subscribe(opt.channels, &Recorder::handle, &rec);
   // A recorder must not be where messages get lost: liblcm 1.3.1 keeps only 30 per subscription.
   sub->setQueueCapacity(1 << 16);

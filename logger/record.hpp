@@ -20,6 +20,10 @@ struct RecordOptions {
   double linger_s = 0.3;                      // after the final result: the other copies, last heartbeats
   const std::atomic<bool>* cancel = nullptr;  // set from a signal handler: stop now
   std::function<void()> on_ready;             // subscribed: messages from now on are recorded
+  // The run key (messages/auth.hpp): every message is still written as received (sealed, and
+  // forgeries too: `replay --key-file` drops them again), but only authentic ones are looked at
+  // to learn the run and its end. Empty: no authentication.
+  std::vector<std::uint8_t> key;
 };
 RecordOptions default_record_options();
 
@@ -31,6 +35,7 @@ struct RecordResult {
   std::uint64_t events = 0, bytes = 0;
   std::vector<std::int64_t> runs;  // run ids announced, in order heard
   std::int64_t done_run = 0;       // the run whose final result ended the recording
+  std::uint64_t unauthenticated = 0;  // with a key: run_start / probabilities that failed the HMAC check
   double elapsed_s = 0.0;
 };
 

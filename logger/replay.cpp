@@ -1,3 +1,4 @@
+#include "sim/body/outcome.hpp"
 #include "logger/replay.hpp"
 
 #include <algorithm>
@@ -15,6 +16,7 @@
 #include "aggregator/target.hpp"
 #include "logger/event_log.hpp"
 #include "logger/log.hpp"
+#include "messages/auth.hpp"
 #include "sim/scene/scene_error.hpp"
 
 namespace dicesim::eventlog {
@@ -31,16 +33,43 @@ std::string list_ids(const std::vector<std::int64_t>& ids) {
 
 // The announcement of the run to replay: the first in the log, or the one asked for. It comes
 // within the first second of a run (and every second after), so this reads little of the file.
-dicesim_lcm::run_start find_run(const std::string& path, std::int64_t want) {
+// Without a key, a log with sealed announcements is refused outright: it is an authenticated
+// run's, and any unsealed run_start in it may be a forgery heard on the bus.
+dicesim_lcm::run_start find_run(const std::string& path, std::int64_t want, const std::vector<std::uint8_t>& key) {
   EventLogReader in(path);
+  wire::Sealer sealer(key);
   std::vector<std::int64_t> seen;
+  std::uint64_t sealed = 0, failed = 0;
+  std::optional<dicesim_lcm::run_start> found;
   while (const lcm::LogEvent* e = in.next()) {
     if (e->channel != wire::kRunStart) continue;
-    auto m = wire::decode<dicesim_lcm::run_start>(e->data, static_cast<std::size_t>(e->datalen));
+    const auto raw = static_cast<std::size_t>(e->datalen);
+    if (wire::looks_sealed(e->data, raw)) {
+      ++sealed;
+      if (!sealer.enabled()) break;
+    }
+    if (found) continue;  // without a key: read on, looking for seals
+    const auto len = sealer.open(e->channel, e->data, raw);
+    if (!len) {
+      ++failed;
+      continue;
+    }
+    auto m = wire::decode<dicesim_lcm::run_start>(e->data, *len);
     if (!m || m->run_id == 0) continue;
-    if (want == 0 || m->run_id == want) return *m;
+    if (want == 0 || m->run_id == want) {
+      found = *m;
+      if (sealer.enabled()) break;
+      continue;
+    }
     if (std::find(seen.begin(), seen.end(), m->run_id) == seen.end()) seen.push_back(m->run_id);
   }
+  if (sealed > 0 && !sealer.enabled())
+    throw LogError("'" + path + "' is the log of an authenticated run (its messages carry HMAC seals): replay it with "
+                   "--key-file FILE, the run's key");
+  if (found) return *found;
+  if (seen.empty() && failed > 0 && sealer.enabled())
+    throw LogError("'" + path + "': none of its " + std::to_string(failed) +
+                   " run_start messages opens with this key (another run's key, or a log without seals)");
   if (want != 0)
     throw LogError("'" + path + "' has no run " + std::to_string(want) + " (runs in it: " + list_ids(seen) + ")");
   throw LogError("'" + path + "' holds no DICESIM_RUN_START message, so it does not describe a run (" +
@@ -76,6 +105,8 @@ struct PassOut {
 PassOut feed(const ReplayOptions& opt, const agg::AggregatorConfig& cfg, lcm::LCM* bus, ReplayResult& res) {
   PassOut out;
   agg::Aggregator agg(cfg, [](const char*, const std::vector<std::uint8_t>&) {});  // its replies go nowhere
+  wire::Sealer sealer(cfg.key);  // for what is read here besides the aggregator (which checks for itself)
+  res.results_in_log = 0;
   EventLogReader in(opt.path);
   const std::int64_t run = cfg.spec.run_id;
   std::set<std::int64_t> workers;
@@ -103,8 +134,19 @@ PassOut feed(const ReplayOptions& opt, const agg::AggregatorConfig& cfg, lcm::LC
     }
     if (!is_dicesim(e->channel)) continue;
     const auto* data = e->data;
-    const auto len = static_cast<std::size_t>(e->datalen);
-    if (e->channel == wire::kWorkerStatus) {
+    const auto raw = static_cast<std::size_t>(e->datalen);
+    // The aggregator judges the raw bytes itself (and counts what fails); here only authentic ones.
+    if (!agg.finished()) {
+      agg.on_message(e->channel, data, raw, static_cast<double>(ts - ts0) * 1e-6);
+      last_ts = ts;
+    }
+    const auto opened = sealer.open(e->channel, data, raw);
+    if (!opened) continue;
+    const std::size_t len = *opened;
+    if (e->channel == wire::kTossBatch) {
+      if (auto b = wire::decode<dicesim_lcm::toss_batch>(data, len))
+        if (b->run_id == run && b->count > 0) res.results_in_log += static_cast<std::uint64_t>(b->count);
+    } else if (e->channel == wire::kWorkerStatus) {
       if (auto m = wire::decode<dicesim_lcm::worker_status>(data, len))
         if (m->run_id == run && m->state == 1) workers.insert(m->worker_id);
     } else if (e->channel == wire::kProbabilities) {
@@ -116,12 +158,8 @@ PassOut feed(const ReplayOptions& opt, const agg::AggregatorConfig& cfg, lcm::LC
             std::find(res.other_runs.begin(), res.other_runs.end(), m->run_id) == res.other_runs.end())
           res.other_runs.push_back(m->run_id);
     }
-    // Once the answer is in, the rest is only read through: a log truncated or corrupt anywhere
-    // is an error, not a result.
-    if (!agg.finished()) {
-      agg.on_message(e->channel, data, len, static_cast<double>(ts - ts0) * 1e-6);
-      last_ts = ts;
-    }
+    // Once the answer is in, the rest is only read through (above): a log truncated or corrupt
+    // anywhere is an error, not a result.
   }
   res.events = in.events();
   res.bytes = in.offset();
@@ -154,10 +192,10 @@ ReplayOptions default_replay_options() { return ReplayOptions{}; }
 
 ReplayResult replay(const ReplayOptions& opt) {
   ReplayResult res;
-  const dicesim_lcm::run_start start = find_run(opt.path, opt.run_id);
+  const dicesim_lcm::run_start start = find_run(opt.path, opt.run_id, opt.key);
   const Rebuilt rb = rebuild(start);
   res.spec = rb.spec;
-  res.labels = rb.model.face_labels;
+  res.labels = six_outcome_labels(rb.model);
   res.model_matches = rb.matches;
   logging::set_run_id(rb.spec.run_id);
   spdlog::info("replaying run {}: {} ({}), seed {}, {} tosses", rb.spec.run_id, rb.spec.origin, rb.spec.fidelity,
@@ -165,7 +203,8 @@ ReplayResult replay(const ReplayOptions& opt) {
 
   agg::AggregatorConfig cfg;
   cfg.spec = rb.spec;
-  cfg.labels = rb.model.face_labels;
+  cfg.labels = six_outcome_labels(rb.model);
+  cfg.key = opt.key;
   std::unique_ptr<lcm::LCM> bus;
   if (opt.live) {
     bus = std::make_unique<lcm::LCM>(opt.url);
@@ -178,7 +217,7 @@ ReplayResult replay(const ReplayOptions& opt) {
     // carry): its last message says where, S. The widest half-width at S, H* <= H, stops the
     // aggregator's own rule at exactly S: every earlier boundary was wider than H >= H*.
     res.stopped_at_target = true;
-    cfg.target_halfwidth = agg::max_halfwidth(recorded_counts(*res.recorded_final, rb.model.face_labels));
+    cfg.target_halfwidth = agg::max_halfwidth(recorded_counts(*res.recorded_final, six_outcome_labels(rb.model)));
     spdlog::info("the live run stopped early at {} tosses (a target half-width); replaying to the same stop",
                  res.recorded_final->total);
     p = feed(opt, cfg, nullptr, res);
@@ -232,8 +271,10 @@ struct Diff {
 
 }  // namespace
 
-TossCheck check_toss(const std::string& path, std::int64_t run_id, std::uint64_t index) {
-  const dicesim_lcm::run_start start = find_run(path, run_id);
+TossCheck check_toss(const std::string& path, std::int64_t run_id, std::uint64_t index,
+                     const std::vector<std::uint8_t>& key) {
+  const dicesim_lcm::run_start start = find_run(path, run_id, key);
+  wire::Sealer sealer(key);
   const Rebuilt rb = rebuild(start);
   TossCheck c;
   c.spec = rb.spec;
@@ -248,7 +289,9 @@ TossCheck check_toss(const std::string& path, std::int64_t run_id, std::uint64_t
   EventLogReader in(path);
   const auto want = static_cast<std::int64_t>(index);
   while (const lcm::LogEvent* e = in.next()) {
-    const auto len = static_cast<std::size_t>(e->datalen);
+    const auto opened = sealer.open(e->channel, e->data, static_cast<std::size_t>(e->datalen));
+    if (!opened) continue;  // unauthenticated: not evidence
+    const std::size_t len = *opened;
     if (e->channel == wire::kBounceState) {
       auto m = wire::decode<dicesim_lcm::bounce_state>(e->data, len);
       if (!m || m->run_id != rb.spec.run_id) continue;

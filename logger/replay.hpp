@@ -29,6 +29,9 @@ struct ReplayOptions {
   double speed = 1.0;          // with live: 2 = twice as fast as recorded
   const std::atomic<bool>* cancel = nullptr;
   std::function<void(std::uint64_t bytes_read, std::uint64_t file_size)> on_progress;  // now and then
+  // The run key (messages/auth.hpp): only messages whose HMAC seal opens are used (the rest are
+  // counted in health.unauthenticated). Needed for the log of an authenticated run.
+  std::vector<std::uint8_t> key;
 };
 ReplayOptions default_replay_options();
 
@@ -46,6 +49,9 @@ struct ReplayResult {
   bool stopped_at_target = false;    // the live run stopped early (--target-halfwidth): replayed to there
   std::vector<std::int64_t> other_runs;  // further runs announced in the same log
   bool cancelled = false;
+  // Every (authentic) toss result of the run in the log, counted: minus `tosses`, the tosses that
+  // were computed (or sent) more than once, e.g. re-leased after a lost batch or an aggregator restart.
+  std::uint64_t results_in_log = 0;
 };
 
 // Throws LogError (unreadable, corrupt or truncated log; no such run; the log does not hold the
@@ -71,6 +77,7 @@ struct TossCheck {
 };
 
 // Throws LogError when the log has no bounce state for `index` (the message lists traced indices).
-TossCheck check_toss(const std::string& path, std::int64_t run_id, std::uint64_t index);
+TossCheck check_toss(const std::string& path, std::int64_t run_id, std::uint64_t index,
+                     const std::vector<std::uint8_t>& key = {});
 
 }  // namespace dicesim::eventlog

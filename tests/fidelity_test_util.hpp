@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "scenes_for_tests.hpp"
 #include "sim/body/die_model.hpp"
@@ -10,6 +11,14 @@
 #include "sim/study/monte_carlo.hpp"
 
 namespace dicesim::testing {
+
+// Counts pinned by face index (+x, -x, +y, -y, +z, -z: as first recorded for the box), in the
+// label order RunCounts uses.
+inline std::vector<std::uint64_t> in_label_order(const DieModel& m, const std::array<std::uint64_t, 6>& by_face) {
+  std::vector<std::uint64_t> out(static_cast<std::size_t>(m.outcomes()), 0);
+  for (std::size_t f = 0; f < 6; ++f) out[static_cast<std::size_t>(m.face_outcome[f])] += by_face[f];
+  return out;
+}
 
 inline SceneDef with_fidelity(SceneDef s, Fidelity f) {
   s.sim.fidelity = f;

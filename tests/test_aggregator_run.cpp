@@ -6,6 +6,7 @@
 #include <memory>
 #include <random>
 
+#include "sim/body/outcome.hpp"
 #include "aggregator/aggregator.hpp"
 #include "aggregator/target.hpp"
 #include "messages/run_spec.hpp"
@@ -84,7 +85,7 @@ struct Fixture {
     model = wire::compile_spec(spec);
     spec.fingerprint = wire::model_fingerprint(model);
     cfg.spec = spec;
-    cfg.labels = model.face_labels;
+    cfg.labels = six_outcome_labels(model);
     cfg.max_lease = 700;
     cfg.min_lease = 150;
     cfg.target_halfwidth = target;

@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <map>
 #include <random>
 #include <stdexcept>
@@ -504,6 +506,396 @@ TEST(MassProperties, UnknownMaterialThrows) {
   DieDef die = seed_die({{Vec3(0, 0, -1), 0.0}});
   die.regions[0].material = "gold";
   EXPECT_THROW(compute_mass_properties(die, kMaterials), std::out_of_range);
+}
+
+}  // namespace
+}  // namespace dicesim
+
+// ---- Any convex polytope, meshes, rounding ----------------------------------------------------
+#include "sim/body/body.hpp"
+#include "sim/body/labels.hpp"
+#include "sim/body/rounding.hpp"
+#include "sim/body/shape.hpp"
+#include "sim/scene/scene.hpp"
+
+namespace dicesim {
+namespace {
+
+constexpr double kDensity = 1200.0;
+
+Body shaped(const std::string& die_keys, const std::string& extra = "") {
+  return build_body(parse_scene("[materials.plastic]\ndensity = 1200.0\n" + extra + "[die]\nmaterial = \"plastic\"\n" +
+                                    die_keys,
+                                "test"),
+                    "test");
+}
+
+void expect_isotropic(const MassProperties& mp, double moment, double mass) {
+  EXPECT_NEAR(mp.mass, mass, kRel * mass);
+  EXPECT_LE(mp.com.norm(), 1e-14);
+  expect_matrix_near(mp.inertia, moment * Mat3::Identity(), kRel * moment);
+}
+
+// Closed forms by edge a (e.g. Wikipedia's tables of the Platonic solids; I about the centre, the
+// same about every axis), a from size = distance between opposite faces (d4: face to vertex):
+//   tetrahedron  H = a sqrt(2/3)            V = a^3 / (6 sqrt2)         I = M a^2 / 20
+//   cube         a = size                   V = a^3                     I = M a^2 / 6
+//   octahedron   inradius a / sqrt6         V = sqrt2 / 3 a^3           I = M a^2 / 10
+//   dodecahedron inradius a sqrt(250 + 110 sqrt5) / 20, V = (15 + 7 sqrt5) / 4 a^3,  I = M a^2 (95 + 39 sqrt5) / 300
+//   icosahedron  inradius phi^2 a / (2 sqrt3), V = 5 (3 + sqrt5) / 12 a^3,         I = M a^2 phi^2 / 10
+TEST(PresetMassProperties, PlatonicSolidsMatchClosedForms) {
+  const double s = 0.02, r5 = std::sqrt(5.0), phi = (1.0 + r5) / 2.0;
+  struct Case {
+    const char* shape;
+    double a, volume, moment_per_ma2;
+  };
+  const double a4 = s * std::sqrt(1.5), a8 = s / 2.0 * std::sqrt(6.0), a12 = s / 2.0 * 20.0 / std::sqrt(250.0 + 110.0 * r5),
+               a20 = s / 2.0 * 2.0 * std::sqrt(3.0) / (phi * phi);
+  const Case cases[] = {
+      {"d4", a4, a4 * a4 * a4 / (6.0 * std::sqrt(2.0)), 1.0 / 20.0},
+      {"d6", s, s * s * s, 1.0 / 6.0},
+      {"d8", a8, std::sqrt(2.0) / 3.0 * a8 * a8 * a8, 1.0 / 10.0},
+      {"d12", a12, (15.0 + 7.0 * r5) / 4.0 * a12 * a12 * a12, (95.0 + 39.0 * r5) / 300.0},
+      {"d20", a20, 5.0 * (3.0 + r5) / 12.0 * a20 * a20 * a20, phi * phi / 10.0},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.shape);
+    const Body b = shaped(std::string("shape = \"") + c.shape + "\"\nsize = 0.02\n");
+    const double mass = kDensity * c.volume;
+    expect_isotropic(b.mass, c.moment_per_ma2 * mass * c.a * c.a, mass);
+  }
+}
+
+TEST(PresetMassProperties, D10IsAPyramidSumAndASymmetricTop) {
+  // All faces at distance size/2 from the centre: V = sum over faces of area * (size/2) / 3.
+  const Body b = shaped("shape = \"d10\"\nsize = 0.02\n");
+  double area = 0.0;
+  for (std::size_t f = 0; f < b.shape.faces.size(); ++f) area += face_area(b.shape, f);
+  const double volume = area * 0.01 / 3.0;
+  EXPECT_NEAR(b.mass.mass, kDensity * volume, kRel * kDensity * volume);
+  EXPECT_LE(b.mass.com.norm(), 1e-14);
+  const Mat3& I = b.mass.inertia;
+  EXPECT_NEAR(I(0, 0), I(1, 1), kRel * I(0, 0));
+  EXPECT_LE(std::max({std::abs(I(0, 1)), std::abs(I(0, 2)), std::abs(I(1, 2))}), kRel * I(0, 0));
+}
+
+TEST(PresetMassProperties, PrismMatchesClosedForm) {
+  // Regular n-gon, circumradius R: A = n/2 R^2 sin(2 pi/n), polar moment J = A R^2 / 6 (1 + 2 cos^2(pi/n)).
+  for (int n : {3, 5, 8}) {
+    const double R = 0.01, L = 0.05;
+    const Body b = shaped("shape = \"prism\"\nsides = " + std::to_string(n) + "\nradius = 0.01\nlength = 0.05\n");
+    const double area = n / 2.0 * R * R * std::sin(2.0 * kPi / n);
+    const double mass = kDensity * area * L;
+    const double izz = mass * R * R / 6.0 * (1.0 + 2.0 * std::pow(std::cos(kPi / n), 2));
+    const double ixx = izz / 2.0 + mass * L * L / 12.0;
+    EXPECT_NEAR(b.mass.mass, mass, kRel * mass);
+    expect_matrix_near(b.mass.inertia, Vec3(ixx, ixx, izz).asDiagonal().toDenseMatrix(), kRel * ixx);
+  }
+}
+
+TEST(SurfaceMoments, ClippingAnyPolytopeMatchesTheBoxClipper) {
+  // The general clipper (triangles, caps fanned) against the box clipper, random cuts.
+  const Vec3 size(0.03, 0.02, 0.025);
+  const Triangles box = shape_triangles(box_shape(size));
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<HalfSpace> cuts;
+    const int n = 1 + trial % 3;
+    for (int k = 0; k < n; ++k) cuts.push_back({Vec3(u(rng), u(rng), u(rng)), 0.01 * u(rng)});
+    expect_moments_near(clipped_surface_moments(box, cuts), clipped_box_moments(size, cuts), size.prod(), 0.03);
+  }
+}
+
+// An L-shaped (non-convex) closed mesh: the unit cube [0,2]x[0,1]x[0,1] plus [0,1]x[1,2]x[0,1].
+std::string l_shape_obj() {
+  return R"(# an L: three unit cubes
+v 0 0 0
+v 2 0 0
+v 2 1 0
+v 1 1 0
+v 1 2 0
+v 0 2 0
+v 0 0 1
+v 2 0 1
+v 2 1 1
+v 1 1 1
+v 1 2 1
+v 0 2 1
+f 1 6 5 4 3 2
+f 7 8 9 10 11 12
+f 1 2 8 7
+f 2 3 9 8
+f 3 4 10 9
+f 4 5 11 10
+f 5 6 12 11
+f 6 1 7 12
+)";
+}
+
+TEST(MeshMassProperties, NonConvexMeshWithARegionIsExact) {
+  const std::string path = ::testing::TempDir() + "/l_shape.obj";
+  std::ofstream(path) << l_shape_obj();
+  const std::string scene = "[materials.plastic]\ndensity = 1000.0\n[materials.lead]\ndensity = 11000.0\n"
+                            "[die]\nmaterial = \"plastic\"\nshape = \"mesh\"\nmesh = \"" + path + "\"\nscale = 0.01\n";
+  const Body b = build_body(parse_scene(scene, "test"), "test");
+  EXPECT_FALSE(b.convex);
+  EXPECT_EQ(b.shape.faces.size(), 7u) << "the L's hull is a pentagonal prism";
+  // Three cubes of 1 cm (1e-6 m^3) centred at (0.5, 0.5, 0.5), (1.5, 0.5, 0.5), (0.5, 1.5, 0.5) cm.
+  EXPECT_NEAR(b.mass.mass, 3e-3, 1e-15);
+  EXPECT_LE((b.mass.com - 0.01 * Vec3(2.5 / 3.0, 2.5 / 3.0, 0.5)).norm(), 1e-15);
+  // Lead where x <= 0.5 cm: a 0.5 x 2 x 1 cm slab centred at (0.25, 1, 0.5) cm.
+  const Body loaded = build_body(
+      parse_scene(scene + "[[die.regions]]\nmaterial = \"lead\"\ncuts = [{normal = [1, 0, 0], offset = 0.005}]\n", "test"),
+      "test");
+  EXPECT_NEAR(loaded.mass.mass, 3e-3 + 10000.0 * 1e-6, 1e-14);
+  const Vec3 first = 1e-3 * 0.01 * Vec3(2.5, 2.5, 1.5) + 10000.0 * 1e-6 * 0.01 * Vec3(0.25, 1.0, 0.5);
+  EXPECT_LE((loaded.mass.com - first / loaded.mass.mass).norm(), 1e-15);
+}
+
+TEST(SurfaceMoments, CutsOfANonConvexSolidCloseEveryCapLoop) {
+  // The L cut by y <= 0.5 then by x >= 0.25: one cap per cut, the second cap crossing the first.
+  // By hand: y <= 0.5 keeps [0,2]x[0,0.5]x[0,1] (volume 1); x >= 0.25 then [0.25,2]x[0,0.5]x[0,1].
+  // Cut the other way, x <= 0.5 keeps [0,0.5]x[0,2]x[0,1] (volume 1), a cap across both arms.
+  // And the plane x + y <= 1.25 cuts both arms of the L: its cap is one non-convex region.
+  Triangles l;
+  std::istringstream in(l_shape_obj());
+  std::vector<Vec3> v;
+  std::vector<std::vector<int>> f;
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream w(line);
+    std::string k;
+    w >> k;
+    if (k == "v") {
+      Vec3 p;
+      w >> p.x() >> p.y() >> p.z();
+      v.push_back(p);
+    } else if (k == "f") {
+      std::vector<int> loop;
+      for (int i; w >> i;) loop.push_back(i - 1);
+      f.push_back(loop);
+    }
+  }
+  for (const auto& loop : f)
+    for (std::size_t k = 1; k + 1 < loop.size(); ++k) l.push_back({v[loop[0]], v[loop[k]], v[loop[k + 1]]});
+  EXPECT_NEAR(surface_moments(l).volume, 3.0, 1e-14);
+  EXPECT_NEAR(clipped_surface_moments(l, {{Vec3(0, 1, 0), 0.5}}).volume, 1.0, 1e-14);
+  EXPECT_NEAR(clipped_surface_moments(l, {{Vec3(0, 1, 0), 0.5}, {Vec3(-1, 0, 0), -0.25}}).volume, 1.75 * 0.5, 1e-14);
+  const VolumeMoments slab = clipped_surface_moments(l, {{Vec3(1, 0, 0), 0.5}});
+  EXPECT_NEAR(slab.volume, 1.0, 1e-14);
+  EXPECT_LE((slab.first - Vec3(0.25, 1.0, 0.5)).norm(), 1e-14);
+  // x + y <= 1.25: the triangle x, y >= 0, x + y <= 1.25 (area 1.25^2/2) lies inside the L
+  // (it stays within x <= 1 or y <= 1), times height 1.
+  EXPECT_NEAR(clipped_surface_moments(l, {{Vec3(1, 1, 0), 1.25}}).volume, 1.25 * 1.25 / 2.0, 1e-14);
+  // The plane x + y = 2.5 crosses the L twice (it passes the notch at (1.25, 1.25)): two cap
+  // loops. x + y >= 2.5 keeps the two arm tips, triangles of legs 0.5 each; x + y <= 2.5 the rest.
+  EXPECT_NEAR(clipped_surface_moments(l, {{Vec3(-1, -1, 0), -2.5}}).volume, 0.25, 1e-14);
+  const VolumeMoments rest = clipped_surface_moments(l, {{Vec3(1, 1, 0), 2.5}});
+  EXPECT_NEAR(rest.volume, 2.75, 1e-14);
+  // Tips' centroids: (2 - 1/6, 1 - 1/6 ... ) i.e. (11/6, 5/6) and (5/6, 11/6): first moment of the
+  // rest = whole - tips.
+  const Vec3 tips = 0.125 * Vec3(11.0 / 6.0, 5.0 / 6.0, 0.5) + 0.125 * Vec3(5.0 / 6.0, 11.0 / 6.0, 0.5);
+  EXPECT_LE((rest.first - (surface_moments(l).first - tips)).norm(), 1e-14);
+}
+
+TEST(MeshMassProperties, MeshOfAPresetEqualsThePreset) {
+  const Body d20 = shaped("shape = \"d20\"\nsize = 0.02\n");
+  std::ostringstream obj;
+  obj.precision(17);
+  for (const Vec3& p : d20.shape.vertices) obj << "v " << p.x() * 1000 << ' ' << p.y() * 1000 << ' ' << p.z() * 1000 << '\n';
+  for (const auto& loop : d20.shape.faces) {
+    obj << "f";
+    for (int i : loop) obj << ' ' << i + 1 << "//" << i + 1;
+    obj << '\n';
+  }
+  const std::string path = ::testing::TempDir() + "/d20.obj";
+  std::ofstream(path) << obj.str();
+  const Body mesh = shaped("shape = \"mesh\"\nmesh = \"" + path + "\"\nscale = 0.001\n");
+  EXPECT_TRUE(mesh.convex);
+  EXPECT_EQ(mesh.shape.faces.size(), 20u);
+  EXPECT_NEAR(mesh.mass.mass, d20.mass.mass, kRel * d20.mass.mass);
+  expect_matrix_near(mesh.mass.inertia, d20.mass.inertia, kRel * d20.mass.inertia.trace());
+  for (std::size_t v = 0; v < mesh.shape.vertices.size(); ++v)
+    EXPECT_LE((mesh.shape.vertices[v] - d20.shape.vertices[v]).norm(), 1e-15);
+}
+
+// Gauss-Legendre nodes and weights on [0, 1] (n points, Newton on the Legendre polynomial).
+void gauss_legendre(int n, std::vector<double>& x, std::vector<double>& w) {
+  x.resize(n);
+  w.resize(n);
+  for (int i = 0; i < n; ++i) {
+    double z = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 0.0;
+    for (int it = 0; it < 100; ++it) {
+      double p0 = 1.0, p1 = z;
+      for (int k = 2; k <= n; ++k) {
+        const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
+        p0 = p1;
+        p1 = p2;
+      }
+      dp = n * (z * p1 - p0) / (z * z - 1.0);
+      const double dz = p1 / dp;
+      z -= dz;
+      if (std::abs(dz) < 1e-16) break;
+    }
+    x[i] = 0.5 * (1.0 - z);
+    w[i] = 1.0 / ((1.0 - z * z) * dp * dp);
+  }
+}
+
+TEST(RoundedPieces, EdgeWedgeMatchesQuadrature) {
+  const Vec3 a(0.01, -0.02, 0.005), b(0.03, 0.01, -0.01);
+  const Vec3 e = (b - a).normalized();
+  const Vec3 u = e.unitOrthogonal();
+  const double angle = 1.1;
+  const Vec3 v = std::cos(angle) * u + std::sin(angle) * e.cross(u);
+  const double r = 0.004, L = (b - a).norm();
+  std::vector<double> x, w;
+  gauss_legendre(24, x, w);
+  VolumeMoments q;
+  const Vec3 wdir = e.cross(u);
+  for (int i = 0; i < 24; ++i)
+    for (int j = 0; j < 24; ++j)
+      for (int k = 0; k < 24; ++k) {
+        const double s = L * x[i], rho = r * x[j], phi = angle * x[k];
+        const double dv = w[i] * w[j] * w[k] * L * r * angle * rho;
+        const Vec3 p = a + s * e + rho * (std::cos(phi) * u + std::sin(phi) * wdir);
+        q.volume += dv;
+        q.first += dv * p;
+        q.second += dv * p * p.transpose();
+      }
+  expect_moments_near(edge_wedge_moments(a, b, u, v, r), q, q.volume, 0.03);
+}
+
+TEST(RoundedPieces, CornerSectorMatchesQuadrature) {
+  // A tetrahedron corner at p with edges along e1, e2, e3 (not orthogonal): faces (e1, e2),
+  // (e2, e3), (e3, e1) with outward normals; the normal cone is the spherical triangle of the three
+  // normals, integrated here by mapping the flat triangle of the normals radially onto the sphere:
+  // dOmega = h / |x|^3 dA (h the flat triangle's distance from the centre).
+  const Vec3 p(0.002, -0.001, 0.003);
+  const Vec3 e1 = Vec3(1, 0.2, 0.1).normalized(), e2 = Vec3(0.1, 1, -0.3).normalized(), e3 = Vec3(0.2, 0.3, 1).normalized();
+  // Outward normals of the solid cone {p + a e1 + b e2 + c e3 : a, b, c >= 0}.
+  auto outward = [&](const Vec3& x, const Vec3& y, const Vec3& other) {
+    Vec3 n = x.cross(y).normalized();
+    return n.dot(other) > 0 ? Vec3(-n) : n;
+  };
+  const Vec3 n12 = outward(e1, e2, e3), n23 = outward(e2, e3, e1), n31 = outward(e3, e1, e2);
+  const double angles = std::acos(e1.dot(e2)) + std::acos(e2.dot(e3)) + std::acos(e3.dot(e1));
+  const std::vector<CornerEdge> edges = {{e1, n31, n12}, {e2, n12, n23}, {e3, n23, n31}};
+  const double r = 0.003;
+  const VolumeMoments exact = corner_sector_moments(p, angles, edges, r);
+
+  std::vector<double> x, w;
+  const int n = 40;
+  gauss_legendre(n, x, w);
+  const Vec3 plane_n = (n23 - n12).cross(n31 - n12).normalized();
+  const double h = std::abs(plane_n.dot(n12));
+  const double area2 = (n23 - n12).cross(n31 - n12).norm();  // twice the flat triangle's area
+  VolumeMoments q;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k) {
+        // Duffy: (s, t) in the unit square -> triangle (1 - s, s (1 - t), s t), Jacobian s.
+        const double s = x[i], t = x[j];
+        const Vec3 flat = (1.0 - s) * n12 + s * (1.0 - t) * n23 + s * t * n31;
+        const Vec3 dir = flat.normalized();
+        const double domega = w[i] * w[j] * s * area2 * h / std::pow(flat.norm(), 3);
+        const double rho = r * x[k];
+        const double dv = domega * w[k] * r * rho * rho;
+        const Vec3 pt = p + rho * dir;
+        q.volume += dv;
+        q.first += dv * pt;
+        q.second += dv * pt * pt.transpose();
+      }
+  expect_moments_near(exact, q, q.volume, 0.005, 1e-11);
+}
+
+TEST(RoundedMassProperties, RoundedCubeMatchesSteinerAndAnIndependentDecomposition) {
+  const double s = 0.016, r = 0.002, c = s - 2.0 * r;
+  const Body b = shaped("shape = \"d6\"\nsize = 0.016\nrounding = 0.002\n");
+  EXPECT_EQ(b.shape.rounding, r);
+  // Steiner: V = c^3 + 6 c^2 r + 3 pi c r^2 + 4/3 pi r^3 (12 edges of quarter cylinders, angle pi/2).
+  const double volume = c * c * c + 6.0 * c * c * r + 3.0 * kPi * c * r * r + 4.0 / 3.0 * kPi * r * r * r;
+  EXPECT_NEAR(b.mass.mass, kDensity * volume, kRel * kDensity * volume);
+  EXPECT_NEAR(RoundedSolid(b.shape, r).steiner_volume(), volume, kRel * volume);
+  // int x^2 dV over the pieces, axis-aligned (h = c/2):
+  //   core c^5/12; the +-x slabs c^2 ((h+r)^3 - h^3)/3 each; the other four slabs c^3/12 c r each;
+  //   4 edges along x: c^3/12 pi r^2/4 each; 8 other edges: c (h^2 pi r^2/4 + 2 h r^3/3 + pi r^4/16);
+  //   8 corners: h^2 pi r^3/6 + 2 h pi r^4/16 + pi r^5/30.
+  const double h = c / 2.0;
+  const double xx = std::pow(c, 5) / 12.0 + 2.0 * c * c * (std::pow(h + r, 3) - h * h * h) / 3.0 +
+                    4.0 * c * c * c / 12.0 * c * r + 4.0 * c * c * c / 12.0 * kPi * r * r / 4.0 +
+                    8.0 * c * (h * h * kPi * r * r / 4.0 + 2.0 * h * r * r * r / 3.0 + kPi * std::pow(r, 4) / 16.0) +
+                    8.0 * (h * h * kPi * r * r * r / 6.0 + 2.0 * h * kPi * std::pow(r, 4) / 16.0 + kPi * std::pow(r, 5) / 30.0);
+  expect_isotropic(b.mass, kDensity * 2.0 * xx, kDensity * volume);
+}
+
+TEST(RoundedMassProperties, RoundedPresetsKeepTheirSymmetryAndSteinerVolume) {
+  for (const char* shape : {"d4", "d8", "d12", "d20"}) {
+    SCOPED_TRACE(shape);
+    const Body sharp = shaped(std::string("shape = \"") + shape + "\"\nsize = 0.02\n");
+    const Body b = shaped(std::string("shape = \"") + shape + "\"\nsize = 0.02\nrounding = 0.001\n");
+    EXPECT_EQ(b.shape.faces.size(), sharp.shape.faces.size());
+    EXPECT_LT(b.mass.mass, sharp.mass.mass);
+    EXPECT_NEAR(b.mass.mass, kDensity * RoundedSolid(b.shape, 0.001).steiner_volume(), kRel * b.mass.mass);
+    expect_isotropic(b.mass, b.mass.inertia.trace() / 3.0, b.mass.mass);
+    // The flat faces stay where they were: same face planes.
+    for (std::size_t f = 0; f < b.shape.faces.size(); ++f) {
+      const Vec3& n = b.shape.normals[f];
+      const int g = nearest_face(sharp.shape, n);
+      EXPECT_NEAR(n.dot(b.shape.vertices[b.shape.faces[f][0]]) + 0.001,
+                  n.dot(sharp.shape.vertices[sharp.shape.faces[g][0]]), 1e-15);
+    }
+  }
+}
+
+TEST(RoundedMassProperties, ABallIsTheLimitOfATinyCore) {
+  // Core a cube of edge 1e-9: the rounded die is a ball of radius r to first order.
+  const double r = 0.005;
+  const Body b = shaped("shape = \"d6\"\nsize = 0.010000001\nrounding = 0.005\n");
+  const double volume = 4.0 / 3.0 * kPi * r * r * r;
+  EXPECT_NEAR(b.mass.mass, kDensity * volume, 1e-6 * kDensity * volume);
+  expect_matrix_near(b.mass.inertia, 0.4 * b.mass.mass * r * r * Mat3::Identity(), 1e-6 * b.mass.inertia.trace());
+}
+
+TEST(LoadedMassProperties, RegionOnAPresetIsExact) {
+  // A d8 whose z <= 0 half is steel: mass of each half = V/2 rho; the COM moves down by
+  // (rho_s - rho_p) / (rho_s + rho_p) times the half's centroid height (3/8 of the apex height a/sqrt2... for
+  // a square pyramid of height H the centroid is H/4 above the base).
+  const Body b = shaped("shape = \"d8\"\nsize = 0.02\n[[die.regions]]\nmaterial = \"steel\"\ncuts = [{normal = [0, 0, 1]}]\n",
+                        "[materials.steel]\ndensity = 7800.0\n");
+  const double a = 0.01 * std::sqrt(6.0) / 2.0 * std::sqrt(2.0) / 2.0 * 2.0;  // vertex distance: inradius sqrt3
+  const double H = 0.01 * std::sqrt(3.0);                                     // apex height above the equator
+  (void)a;
+  const double volume = 4.0 / 3.0 * H * H * H;  // two square pyramids of base (H sqrt2)^2 and height H
+  EXPECT_NEAR(b.mass.mass, (kDensity + 7800.0) / 2.0 * volume, kRel * b.mass.mass);
+  EXPECT_NEAR(b.mass.com.z(), (kDensity - 7800.0) / (kDensity + 7800.0) * H / 4.0, 1e-15);
+}
+
+}  // namespace
+}  // namespace dicesim
+
+namespace dicesim {
+namespace {
+
+TEST(RoundedMassProperties, SlabCutOfARoundedCubeIsExact) {
+  // A rounded d6 (core edge c = s - 2r, h = c/2) whose z <= 0 half is lead. The cut is
+  // perpendicular to the four vertical edges (split exactly along their length) and misses every
+  // other rounded piece. By symmetry each half has volume V/2; the first moment of the upper half:
+  //   core c^2 h^2/2; top slab c^2 ((h+r)^2 - h^2)/2; 4 side slabs c r h^2/2;
+  //   4 top edges c (h pi r^2/4 + r^3/3); 4 vertical half-edges pi r^2/4 h^2/2;
+  //   4 top corners h pi r^3/6 + pi r^4/16.
+  const double s = 0.016, r = 0.002, c = s - 2.0 * r, h = c / 2.0, lead = 11340.0;
+  const Body b = shaped("shape = \"d6\"\nsize = 0.016\nrounding = 0.002\n[[die.regions]]\nmaterial = \"lead\"\n"
+                        "cuts = [{normal = [0, 0, 1]}]\n",
+                        "[materials.lead]\ndensity = 11340.0\n");
+  const double volume = c * c * c + 6.0 * c * c * r + 3.0 * kPi * c * r * r + 4.0 / 3.0 * kPi * r * r * r;
+  const double zup = c * c * h * h / 2.0 + c * c * ((h + r) * (h + r) - h * h) / 2.0 + 4.0 * c * r * h * h / 2.0 +
+                     4.0 * c * (h * kPi * r * r / 4.0 + r * r * r / 3.0) + 4.0 * kPi * r * r / 4.0 * h * h / 2.0 +
+                     4.0 * (h * kPi * r * r * r / 6.0 + kPi * std::pow(r, 4) / 16.0);
+  const double mass = (kDensity + lead) / 2.0 * volume;
+  EXPECT_NEAR(b.mass.mass, mass, kRel * mass);
+  EXPECT_NEAR(b.mass.com.z(), (kDensity - lead) * zup / mass, 1e-12 * h);
+  EXPECT_LE(b.mass.com.head<2>().norm(), 1e-15);
 }
 
 }  // namespace

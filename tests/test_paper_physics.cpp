@@ -259,9 +259,10 @@ TEST(PaperMonteCarlo, SlabDieMixedFacesAgreeAndHeavyFaceGoesDown) {
   cfg.tosses = 300000;
   cfg.threads = 2;
   const RunCounts c = run_tosses(m, cfg);
-  const std::array<std::uint64_t, 4> mixed{c.faces[0], c.faces[1], c.faces[2], c.faces[3]};
+  // Counts in label order: labels 2-5 are the mixed faces.
+  const std::array<std::uint64_t, 4> mixed{c.faces[1], c.faces[2], c.faces[3], c.faces[4]};
   EXPECT_GT(chi2_uniform(mixed).p_value, 1e-3);
-  const Interval steel_up = wilson_interval(c.faces[4], c.settled, 3.29);
+  const Interval steel_up = wilson_interval(c.faces[0], c.settled, 3.29);
   const Interval alu_up = wilson_interval(c.faces[5], c.settled, 3.29);
   EXPECT_LT(steel_up.hi, alu_up.lo);
 }

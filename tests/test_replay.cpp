@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sim/body/outcome.hpp"
 #include "aggregator/aggregator.hpp"
 #include "cli_runner.hpp"
 #include "logger/event_log.hpp"
@@ -69,7 +70,7 @@ Written write_log(const std::string& path, const LogPlan& plan) {
   };
   dicesim::agg::AggregatorConfig cfg;
   cfg.spec = spec;
-  cfg.labels = model.face_labels;
+  cfg.labels = dicesim::six_outcome_labels(model);
   cfg.target_halfwidth = plan.target_halfwidth;
   std::vector<std::vector<std::uint8_t>> finals;
   dicesim::agg::Aggregator live(cfg, [&](const char* ch, const std::vector<std::uint8_t>& bytes) {

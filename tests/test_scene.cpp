@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -560,6 +561,106 @@ TEST(SceneErrors, MalformedOrUnknownOverride) {
 
   const SceneError ext = error_of([] { load_scene(kDie1, {"extends=x.toml"}); });
   EXPECT_EQ(ext.file(), std::string(kDie1) + " (--set)");
+}
+
+}  // namespace
+}  // namespace dicesim
+
+// ---- Shapes -----------------------------------------------------------------------------------
+namespace dicesim {
+namespace {
+
+SceneError shape_error(const std::string& die_keys) {
+  return error_of([&] { parse_scene(kMinimal + die_keys, "shape.toml"); });
+}
+
+TEST(SceneShapes, EveryShapeKeyIsReadWithItsDefaults) {
+  const SceneDef box = parse_scene(kMinimal, "s");
+  EXPECT_EQ(box.die.shape, ShapeKind::Box);
+  EXPECT_EQ(box.die.rounding, 0.0);
+  EXPECT_FALSE(box.die.read_down.has_value());
+  const SceneDef d20 = parse_scene(kMinimal + "shape = \"d20\"\nsize = 0.02\nrounding = 0.001\nread = \"down\"\n"
+                                                "[[die.labels]]\nnormal = [0, 0, 1]\nlabel = 20\n", "s");
+  EXPECT_EQ(d20.die.shape, ShapeKind::D20);
+  EXPECT_EQ(d20.die.size, Vec3::Constant(0.02));
+  EXPECT_EQ(d20.die.rounding, 0.001);
+  EXPECT_EQ(d20.die.read_down, std::optional<bool>(true));
+  ASSERT_EQ(d20.die.labels.size(), 1u);
+  EXPECT_EQ(d20.die.labels[0].label, 20);
+  const SceneDef prism = parse_scene(kMinimal + "shape = \"prism\"\nsides = 5\nradius = 0.008\nlength = 0.04\n", "s");
+  EXPECT_EQ(prism.die.sides, 5);
+  EXPECT_EQ(prism.die.radius, 0.008);
+  EXPECT_EQ(prism.die.length, 0.04);
+  const SceneDef hull = parse_scene(kMinimal + "shape = \"hull\"\nscale = 0.001\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\n", "s");
+  EXPECT_EQ(hull.die.vertices.size(), 4u);
+  EXPECT_EQ(hull.die.scale, 0.001);
+}
+
+TEST(SceneShapes, MeshTextIsReadRelativeToTheSceneFile) {
+  TempDir dir;
+  dir.write("meshes/cube.obj", "v 0 0 0\n");
+  const std::string scene = dir.write("dice/cube.toml", kMinimal + "shape = \"mesh\"\nmesh = \"../meshes/cube.obj\"\n");
+  const SceneDef s = load_scene(scene);
+  EXPECT_EQ(s.die.mesh, "../meshes/cube.obj");
+  EXPECT_EQ(s.die.mesh_text, "v 0 0 0\n");
+  EXPECT_NE(s.die.mesh_path.find("meshes/cube.obj"), std::string::npos);
+  // A scene that extends it finds the mesh relative to the file the key is written in.
+  const std::string derived = dir.write("other/derived.toml", "extends = \"../dice/cube.toml\"\n");
+  EXPECT_EQ(load_scene(derived).die.mesh_text, "v 0 0 0\n");
+
+  const SceneError missing = error_of([&] { load_scene(dir.write("dice/bad.toml", kMinimal + "shape = \"mesh\"\nmesh = \"nope.obj\"\n")); });
+  EXPECT_EQ(missing.key(), "die.mesh");
+  EXPECT_EQ(missing.value(), "\"nope.obj\"");
+  expect_contains(missing.allowed(), "cannot open mesh file");
+  expect_contains(missing.allowed(), "nope.obj");
+}
+
+TEST(SceneShapes, BadShapeKeysNameKeyValueAndRange) {
+  const SceneError shape = shape_error("shape = \"d7\"\n");
+  EXPECT_EQ(shape.key(), "die.shape");
+  EXPECT_EQ(shape.value(), "\"d7\"");
+  expect_contains(shape.allowed(), "\"d4\", \"d6\"");
+  expect_contains(shape.allowed(), "\"mesh\"");
+
+  const SceneError read = shape_error("read = \"sideways\"\n");
+  EXPECT_EQ(read.key(), "die.read");
+  expect_contains(read.allowed(), "\"up\", \"down\"");
+
+  const SceneError sides = shape_error("shape = \"prism\"\nsides = 2\n");
+  EXPECT_EQ(sides.key(), "die.sides");
+  EXPECT_EQ(sides.value(), "2");
+  expect_contains(sides.allowed(), "integer in [3, 1000]");
+
+  const SceneError not_for = shape_error("shape = \"d20\"\nsides = 5\n");
+  EXPECT_EQ(not_for.key(), "die.sides");
+  expect_contains(not_for.allowed(), "does not apply to shape = \"d20\"");
+
+  const SceneError preset_size = shape_error("shape = \"d8\"\nsize = [0.02, 0.02, 0.02]\n");
+  EXPECT_EQ(preset_size.key(), "die.size");
+  expect_contains(preset_size.allowed(), "distance between opposite faces");
+
+  const SceneError few = shape_error("shape = \"hull\"\nvertices = [[0,0,0],[1,0,0],[0,1,0]]\n");
+  EXPECT_EQ(few.key(), "die.vertices");
+  expect_contains(few.allowed(), "at least 4 points");
+
+  const SceneError missing = shape_error("shape = \"hull\"\n");
+  EXPECT_EQ(missing.key(), "die.vertices");
+  expect_contains(missing.allowed(), "required");
+
+  const SceneError rounding = shape_error("rounding = -0.001\n");
+  EXPECT_EQ(rounding.key(), "die.rounding");
+  expect_contains(rounding.allowed(), "[0, 100) m");
+
+  const SceneError label = shape_error("[[die.labels]]\nnormal = [0, 0, 0]\nlabel = 1\n");
+  EXPECT_EQ(label.key(), "die.labels[0].normal");
+
+  const SceneError mesh_rounding = shape_error("shape = \"mesh\"\nmesh = \"x.obj\"\nrounding = 0.001\n");
+  EXPECT_EQ(mesh_rounding.key(), "die.rounding");
+  expect_contains(mesh_rounding.allowed(), "does not apply to shape = \"mesh\"");
+
+  const SceneError faces = shape_error("shape = \"d8\"\n[die.faces]\n\"+z\" = 1\n");
+  EXPECT_EQ(faces.key(), "die.faces");
+  expect_contains(faces.allowed(), "[[die.labels]]");
 }
 
 }  // namespace

@@ -1,9 +1,15 @@
 // The compiled, immutable die (as MuJoCo's mjModel): everything a toss reads, computed once
 // from a SceneDef. Body frame = principal frame with origin at the centre of mass.
+//
+// Any convex die: a core polytope (vertices, faces of any number of corners) optionally swept by
+// a ball of radius `rounding`. On a flat floor the lowest point of the die is the lowest point of
+// some corner's ball, so every contact is a corner contact whose point lies `rounding` below the
+// corner (contact_point() in sim/dynamics/flight.hpp).
 #pragma once
 
-#include <array>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "sim/body/mass_properties.hpp"
 #include "sim/math.hpp"
@@ -13,12 +19,33 @@ namespace dicesim {
 
 struct DieModel {
   // Geometry in the body (principal, COM-centred) frame.
-  std::array<Vec3, 8> vertices;        // box corners; index bit k set <=> + side along geometric axis k
-  std::array<Vec3, 6> face_normals;    // outward, order +x, -x, +y, -y, +z, -z of the geometric frame
-  std::array<int, 6> face_labels;      // label of each face in that order
-  std::array<double, 8> vertex_restitution;  // per corner: volume-weighted over the corner's materials
-  std::array<double, 8> vertex_friction;
-  double bounding_radius = 0.0;        // max |vertex| from the COM
+  std::vector<Vec3> vertices;              // the core's corners
+  std::vector<double> vertex_restitution;  // per corner: volume-weighted over the corner's materials
+  std::vector<double> vertex_friction;
+  double rounding = 0.0;                   // radius of the ball swept over the core (m)
+  double bounding_radius = 0.0;            // max |vertex| + rounding from the COM
+  // Corner adjacency along the core's edges (CSR): neighbours of v are
+  // vertex_adj[vertex_adj_begin[v] .. vertex_adj_begin[v + 1]).
+  std::vector<int> vertex_adj_begin, vertex_adj;
+  std::vector<int> vertex_adj_edge;  // parallel to vertex_adj: position in face_loop of the edge v -> neighbour
+
+  // Faces, in the shape's order (for a box +x, -x, +y, -y, +z, -z of the geometric frame).
+  std::vector<Vec3> face_normals;   // outward unit normals
+  std::vector<int> face_labels;     // label of each face (several faces may share one: grouped outcomes)
+  // Face loops (CSR): face f's corners, counter-clockwise seen from outside, are
+  // face_loop[face_begin[f] .. face_begin[f + 1]); face_across at the same position k is the face
+  // sharing the edge (loop[k], loop[k + 1]).
+  std::vector<int> face_begin, face_loop, face_across;
+  std::vector<int> loop_face;       // parallel to face_loop: the face of that loop position
+  std::vector<double> face_area;    // of the core's face (m^2)
+
+  // Outcomes: the distinct labels ascending ("label order"); counts and reports use this order.
+  std::vector<int> outcome_labels;
+  std::vector<int> face_outcome;    // per face: index into outcome_labels
+  bool read_down = false;           // the result is the face on the floor (a d4), else the face up
+  // Per face f lying on the floor: the face that is read (f itself when read_down, else the face
+  // whose normal points most nearly up).
+  std::vector<int> face_result;
 
   // Mass properties.
   double mass = 0.0;
@@ -28,13 +55,14 @@ struct DieModel {
   Mat3 geo_to_body = Mat3::Identity();
   bool symmetric_top = false;
 
-  // Resting geometry (sim/rest.hpp), per face in the order above, body frame:
-  std::array<std::array<int, 4>, 6> face_vertices{};  // corners of each face, in cyclic order
-  std::array<double, 6> face_height{};   // COM to the face's plane: the COM height resting on it
-  std::array<double, 6> face_escape{};   // lowest COM height over any edge of the face (tipping barrier)
-  std::array<double, 6> face_tip_ratio{};  // min over edges: (COM projection to edge) / face_height
-  double max_escape = 0.0;               // max of face_escape
-  double max_friction = 0.0;             // max of vertex_friction
+  // Resting geometry (sim/dynamics/rest.hpp), per face, body frame, rounding included:
+  std::vector<double> face_height;     // COM height resting on the face
+  std::vector<double> face_hold;       // min distance from the COM's foot to the face's edges (< 0: cannot hold it)
+  std::vector<double> face_escape;     // lowest pass out of the face's basin (COM height; +inf: no way out)
+  std::vector<double> face_tip_ratio;  // face_hold / face_height: the friction coefficient that tips it
+  std::vector<double> face_gyro;       // |n x I n|: spinning at w about the normal needs a torque w^2 |n x I n|
+  double max_escape = 0.0;             // max of the finite face_escape
+  double max_friction = 0.0;           // max of vertex_friction
 
   // Simulation settings, copied from the scene.
   Fidelity fidelity = Fidelity::Paper;             // the model tosses use (never Auto)
@@ -49,6 +77,21 @@ struct DieModel {
 
   ThrowDef throw_;  // distributions of the initial state (geometric frame for orientation)
   std::string name;
+  std::string kind = "box";  // the scene's die.shape
+  bool convex = true;        // false: a mesh whose solid is not its hull (contact uses the hull)
+
+  int face_count() const { return static_cast<int>(face_normals.size()); }
+  int vertex_count() const { return static_cast<int>(vertices.size()); }
+  int outcomes() const { return static_cast<int>(outcome_labels.size()); }
+  std::span<const int> face_vertices(int f) const {
+    return {face_loop.data() + face_begin[static_cast<std::size_t>(f)],
+            static_cast<std::size_t>(face_begin[static_cast<std::size_t>(f) + 1] - face_begin[static_cast<std::size_t>(f)])};
+  }
+  std::span<const int> neighbours(int v) const {
+    return {vertex_adj.data() + vertex_adj_begin[static_cast<std::size_t>(v)],
+            static_cast<std::size_t>(vertex_adj_begin[static_cast<std::size_t>(v) + 1] -
+                                     vertex_adj_begin[static_cast<std::size_t>(v)])};
+  }
 };
 
 }  // namespace dicesim

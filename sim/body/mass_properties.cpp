@@ -138,11 +138,6 @@ VolumeMoments integrate(const Polyhedron& poly) {
   return m;
 }
 
-void accumulate(VolumeMoments& total, const VolumeMoments& part, double weight) {
-  total.volume += weight * part.volume;
-  total.first += weight * part.first;
-  total.second += weight * part.second;
-}
 
 // Principal moments (ascending) and axes (columns, right-handed), chosen deterministically.
 // The solver's eigenvectors for a repeated moment are an arbitrary basis of its eigenspace, so
@@ -189,7 +184,101 @@ void principal_frame(const Mat3& inertia, Vec3& moments, Mat3& axes) {
   }
 }
 
+// Keeps the part of a closed triangle surface where n.x <= d and closes it again. Each triangle is
+// clipped to a convex polygon (fanned back into triangles); every polygon edge that lies on the
+// plane is a piece of the cut's outline, and the outline pieces of all polygons, reversed, fanned
+// from one point on the plane, form the cap. Edges on the plane shared by two kept polygons come
+// in opposite directions and cancel in the fan, so the cap is right for any closed surface.
+Triangles clip_surface(const Triangles& in, const Vec3& n, double d, double tol) {
+  bool any_outside = false, any_inside = false;
+  for (const auto& t : in)
+    for (const Vec3& p : t) {
+      const double s = n.dot(p) - d;
+      any_outside = any_outside || s > tol;
+      any_inside = any_inside || s < -tol;
+    }
+  if (!any_outside) return in;
+  if (!any_inside) return {};
+  Triangles out;
+  std::vector<std::pair<Vec3, Vec3>> outline;
+  for (const auto& t : in) {
+    std::array<Vec3, 4> poly;
+    std::array<bool, 4> on{};
+    int m = 0;
+    for (int i = 0; i < 3; ++i) {
+      const Vec3& a = t[i];
+      const Vec3& b = t[(i + 1) % 3];
+      const double sa = n.dot(a) - d, sb = n.dot(b) - d;
+      if (sa <= tol) {
+        poly[m] = a;
+        on[m++] = std::abs(sa) <= tol;
+      }
+      if ((sa < -tol && sb > tol) || (sa > tol && sb < -tol)) {
+        // From the inside end: the two triangles sharing this edge get the bit-identical point.
+        const bool a_inside = sa < 0.0;
+        const Vec3& pin = a_inside ? a : b;
+        const Vec3& pout = a_inside ? b : a;
+        const double s_in = a_inside ? sa : sb, s_out = a_inside ? sb : sa;
+        poly[m] = pin + (pout - pin) * (s_in / (s_in - s_out));
+        on[m++] = true;
+      }
+    }
+    if (m < 3) continue;
+    for (int i = 1; i + 1 < m; ++i) out.push_back({poly[0], poly[i], poly[i + 1]});
+    for (int i = 0; i < m; ++i)
+      if (on[i] && on[(i + 1) % m]) outline.emplace_back(poly[i], poly[(i + 1) % m]);
+  }
+  if (!outline.empty()) {
+    const Vec3 q = outline.front().first;
+    for (const auto& [a, b] : outline) out.push_back({q, b, a});
+  }
+  return out;
+}
+
 }  // namespace
+
+void accumulate(VolumeMoments& total, const VolumeMoments& part, double weight) {
+  total.volume += weight * part.volume;
+  total.first += weight * part.first;
+  total.second += weight * part.second;
+}
+
+VolumeMoments surface_moments(const Triangles& surface) {
+  VolumeMoments m;
+  if (surface.empty()) return m;
+  Vec3 apex = Vec3::Zero();
+  for (const auto& t : surface) apex += t[0] + t[1] + t[2];
+  apex /= static_cast<double>(3 * surface.size());
+  for (const auto& t : surface) add_tetrahedron(apex, t[0], t[1], t[2], m);
+  return m;
+}
+
+Triangles clipped_surface(const Triangles& surface, const std::vector<HalfSpace>& cuts) {
+  for (const HalfSpace& cut : cuts) check_cut(cut);
+  if (surface.empty()) return {};
+  Vec3 lo = surface[0][0], hi = lo;
+  for (const auto& t : surface)
+    for (const Vec3& p : t) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  const double size = (hi - lo).norm();
+  const double reach = lo.cwiseAbs().cwiseMax(hi.cwiseAbs()).norm();
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  Triangles clipped = surface;
+  for (const HalfSpace& cut : cuts) {
+    const double length = cut.normal.norm();
+    const double offset = cut.offset / length;
+    const double tol = 1e-12 * size + 8.0 * kEps * (reach + std::abs(offset));
+    clipped = clip_surface(clipped, cut.normal / length, offset, tol);
+    if (clipped.empty()) return {};
+  }
+  return clipped;
+}
+
+VolumeMoments clipped_surface_moments(const Triangles& surface, const std::vector<HalfSpace>& cuts) {
+  return surface_moments(clipped_surface(surface, cuts));
+}
 
 VolumeMoments clipped_aabb_moments(const Vec3& lo, const Vec3& hi, const std::vector<HalfSpace>& cuts) {
   if (!lo.allFinite() || !hi.allFinite() || (hi - lo).minCoeff() < 0.0)
@@ -231,10 +320,14 @@ MassProperties compute_mass_properties(const DieDef& die, const std::map<std::st
     accumulate(mass_moments, clipped_box_moments(die.size, region.half_spaces),
                materials.at(region.material).density - base_density);
 
+  return mass_properties_from_moments(mass_moments);
+}
+
+MassProperties mass_properties_from_moments(const VolumeMoments& mass_moments) {
   MassProperties mp;
   mp.mass = mass_moments.volume;
   // No mass (a zero-size die): nothing else is defined. Report the mass alone and leave the rest at
-  // its defaults; the caller rejects it with a message naming the scene key (sim/models/compile.cpp).
+  // its defaults; the caller rejects it with a message naming the scene key (sim/body/body.cpp).
   if (!(mp.mass > 0.0) || !std::isfinite(mp.mass)) return mp;
   mp.com = mass_moments.first / mp.mass;
   // Parallel-axis theorem on the second moment, then I = tr(S) 1 - S (already density-weighted).

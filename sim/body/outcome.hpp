@@ -1,23 +1,37 @@
-// Reading the result: the face whose outward normal points most nearly up.
+// Reading the result: the face whose outward normal points most nearly up (or, for a die read
+// from below such as a d4, most nearly down), and the outcome (label) it shows.
 #pragma once
+
+#include <array>
+#include <stdexcept>
 
 #include "sim/body/die_model.hpp"
 
 namespace dicesim {
 
-// Index (0..5, order +x, -x, +y, -y, +z, -z of the geometric frame) of the face most aligned
-// with +z for body->world rotation R. Ties go to the lower index (deterministic).
-inline int top_face_index(const DieModel& m, const Mat3& R) {
+// Index of the face most aligned with +z (read_down: with -z) for body->world rotation R.
+// Ties go to the lower index (deterministic).
+inline int read_face_index(const DieModel& m, const Mat3& R) {
   int best = 0;
   double best_z = -2.0;
-  for (int f = 0; f < 6; ++f) {
-    const double z = R.row(2).dot(m.face_normals[f]);
+  const double sign = m.read_down ? -1.0 : 1.0;
+  const int n = m.face_count();
+  for (int f = 0; f < n; ++f) {
+    const double z = sign * R.row(2).dot(m.face_normals[static_cast<std::size_t>(f)]);
     if (z > best_z) {
       best_z = z;
       best = f;
     }
   }
   return best;
+}
+
+// The model's outcome labels when it has exactly six (the LCM wire carries six until it carries N).
+inline std::array<int, 6> six_outcome_labels(const DieModel& m) {
+  if (m.outcomes() != 6) throw std::invalid_argument("the die does not have six outcomes");
+  std::array<int, 6> out{};
+  for (std::size_t i = 0; i < 6; ++i) out[i] = m.outcome_labels[i];
+  return out;
 }
 
 }  // namespace dicesim

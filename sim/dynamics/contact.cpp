@@ -4,7 +4,7 @@ namespace dicesim {
 
 Impact apply_vertex_impact(const DieModel& m, RigidState& s, int vertex) {
   Impact out;
-  const Vec3 r = s.R * m.vertices[vertex];
+  const Vec3 r = contact_point(m, s.R, vertex);
   out.contact_point = r;
   const double vn = s.velocity.z() + (s.omega.x() * r.y() - s.omega.y() * r.x());  // (v + w x r).z
   if (vn >= 0.0) return out;

@@ -52,7 +52,7 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
     }
     low = std::min(low, R.row(2).dot(verts[i]));
   }
-  return p.z() + v.z() * t + low;
+  return p.z() + v.z() * t + low - m_->rounding;  // a rounded corner touches with its ball
 }
 
 void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, double* first_touch) {
@@ -134,7 +134,7 @@ int FixedStepper::step(RigidState& s) {
           ++j;
           continue;
         }
-        g_lo = std::min(g_lo, s0.position.z() + z_row.dot(m.vertices[i]));
+        g_lo = std::min(g_lo, s0.position.z() + z_row.dot(m.vertices[i]) - m.rounding);
       }
     }
     double d_lo = 0.0, d_hi = h_, g_hi = a_.G;
@@ -233,8 +233,9 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
     if (n == 0) {
       if (!allow_liftoff) continue;
       bool clear = true;
-      for (const Vec3& v : m.vertices) {
-        const Vec3 ri = s.R * v;
+      const int nv = m.vertex_count();
+      for (int i = 0; i < nv && clear; ++i) {
+        const Vec3 ri = contact_point(m, s.R, i);
         const double z = s.position.z() + ri.z();
         const double vz = (s.velocity + s.omega.cross(ri)).z();
         clear = z + 2.0 * h * std::min(0.0, vz) - 2.0 * g * h * h > 1e-9 * r;

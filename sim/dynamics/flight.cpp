@@ -67,9 +67,11 @@ ContactSearch Flight::next_contact(double t_limit) const {
     double step = std::numeric_limits<double>::infinity();
     int touching = -1;
     double touching_z = std::numeric_limits<double>::infinity();
-    for (int i = 0; i < 8; ++i) {
-      const Vec3 p = R * model_->vertices[i];
-      const double z = zc + p.z();
+    const int n = model_->vertex_count();
+    const double rounding = model_->rounding;
+    for (int i = 0; i < n; ++i) {
+      const Vec3 p = R * model_->vertices[static_cast<std::size_t>(i)];
+      const double z = zc + p.z() - rounding;  // the lowest point of the corner's ball
       const double zdot = vz + (w.x() * p.y() - w.y() * p.x());
       if (z <= contact_tol_ && zdot < 0.0) {
         if (z < touching_z) {

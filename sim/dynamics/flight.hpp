@@ -43,6 +43,19 @@ class Flight {
   double contact_tol_;  // a vertex this close to the floor (m) counts as touching
 };
 
+// Where corner v touches a floor below it, relative to the COM (world): the lowest point of the
+// corner's ball, `rounding` below the corner (the corner itself for a sharp die).
+inline Vec3 contact_point(const DieModel& m, const Mat3& R, int v) {
+  Vec3 r = R * m.vertices[static_cast<std::size_t>(v)];
+  r.z() -= m.rounding;
+  return r;
+}
+
+// Height above the floor of corner v's lowest point.
+inline double corner_height(const DieModel& m, const RigidState& s, int v) {
+  return s.position.z() + s.R.row(2).dot(m.vertices[static_cast<std::size_t>(v)]) - m.rounding;
+}
+
 // World inertia tensor of the die at orientation R: R diag(I) R^T.
 inline Mat3 world_inertia(const DieModel& m, const Mat3& R) {
   return R * m.principal_moments.asDiagonal() * R.transpose();

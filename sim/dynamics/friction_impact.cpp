@@ -338,9 +338,27 @@ SweepResult solve_friction(const Body& b, const Points& pts, const double radius
 
 ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol) {
   ContactSet c;
-  const int nv = static_cast<int>(m.vertices.size());
-  for (int i = 0; i < nv && c.n < kMaxContacts; ++i)
-    if (s.position.z() + s.R.row(2).dot(m.vertices[i]) <= tol) c.vertex[c.n++] = i;
+  double z[kMaxContacts];
+  const int nv = m.vertex_count();
+  for (int i = 0; i < nv; ++i) {
+    const double zi = corner_height(m, s, i);
+    if (zi > tol) continue;
+    if (c.n < kMaxContacts) {
+      z[c.n] = zi;
+      c.vertex[c.n++] = i;
+      continue;
+    }
+    int hi = 0;  // full: replace the highest if this one is lower
+    for (int k = 1; k < c.n; ++k)
+      if (z[k] > z[hi]) hi = k;
+    if (zi < z[hi]) {
+      z[hi] = zi;
+      c.vertex[hi] = i;
+    }
+  }
+  // Ascending vertex order, as the stepper's search for new contacts expects.
+  for (int a = 1; a < c.n; ++a)
+    for (int b = a; b > 0 && c.vertex[b - 1] > c.vertex[b]; --b) std::swap(c.vertex[b - 1], c.vertex[b]);
   return c;
 }
 
@@ -357,7 +375,7 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
   double u0n[kMaxContacts];
   for (int i = 0; i < c.n; ++i) {
     const int v = c.vertex[i];
-    pts.r[i] = s.R * m.vertices[v];
+    pts.r[i] = contact_point(m, s.R, v);
     pts.e[i] = m.vertex_restitution[v];
     pts.mu[i] = m.vertex_friction[v];
     const Mat3 W = compliance(b, pts.r[i]);

@@ -34,8 +34,8 @@
 
 namespace dicesim {
 
-// Simultaneous contact points one solve handles (a face of up to 32 corners; more are ignored
-// beyond the lowest 32, which no ready scene reaches).
+// Simultaneous contact points one solve handles: a face of more corners touches at the
+// kMaxContacts lowest (enough to carry any load on a flat floor; no ready scene reaches it).
 inline constexpr int kMaxContacts = 32;
 
 // The corners of the die that touch the floor at one instant.
@@ -59,7 +59,8 @@ struct ImpactResult {
   Corrections corrections;      // energy clamp, unconverged solve, fallback of this impact
 };
 
-// Corners of `s` whose height is at most `tol` (m).
+// Corners of `s` whose contact point (the lowest point of the corner's ball) is at most `tol` (m)
+// above the floor; of more than kMaxContacts, the lowest.
 ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol);
 
 // Impact with restitution (true) or perfectly plastic (false, used for sustained contact), with
@@ -71,7 +72,7 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
 
 // Velocity of corner `vertex`'s contact point (world).
 inline Vec3 corner_velocity(const DieModel& m, const RigidState& s, int vertex) {
-  return s.velocity + s.omega.cross(s.R * m.vertices[vertex]);
+  return s.velocity + s.omega.cross(contact_point(m, s.R, vertex));
 }
 
 }  // namespace dicesim

@@ -7,124 +7,216 @@
 namespace dicesim {
 namespace {
 
-// The face that shares edge (a, b) with face f (a and b are corners of f that differ in one bit).
-int face_across(int f, int a, int b) {
-  const int k = __builtin_ctz(static_cast<unsigned>(a ^ b));  // the edge runs along axis k
-  for (int axis = 0; axis < 3; ++axis) {
-    if (axis == k || axis == f / 2) continue;
-    return 2 * axis + (((a >> axis) & 1) ? 0 : 1);
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Each roll step lowers the COM, so the roll ends; the guard only bounds rounding trouble.
+int roll_guard(const DieModel& m) { return 4 * (m.face_count() + m.vertex_count()) + 16; }
+
+int roll_face(const DieModel& m, int f, double tiebreak, int& guard);
+
+// Pivot about corner p (the lowest, on the floor) of the die in orientation R.
+int roll_vertex(const DieModel& m, Mat3 R, int p, double tiebreak, int& guard) {
+  const double tiny = 1e-12 * m.bounding_radius;
+  while (guard-- > 0) {
+    const Vec3 wp = R * m.vertices[static_cast<std::size_t>(p)];
+    // 1. Pivot about corner p: the COM falls in the vertical plane through p and itself.
+    Vec3 dh(-wp.x(), -wp.y(), 0.0);  // horizontal COM offset from p
+    if (dh.norm() <= tiny) {         // COM straight above the corner: the toss decides the way
+      const double a = 2.0 * kPi * tiebreak;
+      dh = Vec3(std::cos(a), std::sin(a), 0.0);
+    }
+    const Vec3 axis = Vec3::UnitZ().cross(dh).normalized();
+    // The first theta in [0, pi] with A cos + B sin = 0 is atan2(A, -B); on [0, pi] the angle
+    // grows with -cos(theta) = B / hypot(A, B), so the smallest is found, and its cos and sin are
+    // known, without any trigonometric call. Only corners joined to p by an edge can touch first.
+    int q = -1, q_edge = -1;
+    double key = kInf, cos_t = 1.0, sin_t = 0.0;
+    Vec3 wq = Vec3::Zero();
+    const int adj0 = m.vertex_adj_begin[static_cast<std::size_t>(p)];
+    const int adj1 = m.vertex_adj_begin[static_cast<std::size_t>(p) + 1];
+    for (int a = adj0; a < adj1; ++a) {
+      const int j = m.vertex_adj[static_cast<std::size_t>(a)];
+      const Vec3 wj = R * m.vertices[static_cast<std::size_t>(j)];
+      const Vec3 u = wj - wp;
+      const double A = std::max(0.0, u.z()), B = axis.cross(u).z();
+      const double h = std::sqrt(A * A + B * B);
+      const double kk = h > 0.0 ? B / h : -1.0;  // (a degenerate edge: theta = 0)
+      if (kk < key) {
+        key = kk;
+        q = j;
+        q_edge = m.vertex_adj_edge[static_cast<std::size_t>(a)];
+        wq = wj;
+        cos_t = h > 0.0 ? -B / h : 1.0;
+        sin_t = h > 0.0 ? A / h : 0.0;
+      }
+    }
+    if (q < 0) return -1;
+    // Rodrigues: rot = cos I + sin [axis]x + (1 - cos) axis axis^T.
+    Mat3 cross_axis;
+    cross_axis << 0.0, -axis.z(), axis.y(), axis.z(), 0.0, -axis.x(), -axis.y(), axis.x(), 0.0;
+    const Mat3 rot = cos_t * Mat3::Identity() + sin_t * cross_axis + (1.0 - cos_t) * (axis * axis.transpose());
+
+    // 2. Edge p-q on the floor. If the COM projects beyond q, the die pivots on q alone.
+    const Vec3 c = rot * (-wp);
+    const Vec3 pq = rot * (wq - wp);
+    const double len = pq.norm();
+    const Vec3 e = pq / len;
+    if (c.dot(e) > len * (1.0 + 1e-12)) {
+      R = rot * R;
+      p = q;
+      continue;
+    }
+    // Tip about the edge toward the side of the COM: of the edge's two faces, the one whose
+    // normal points more toward the COM's side goes down.
+    Vec3 s = c - c.dot(e) * e;
+    s.z() = 0.0;
+    const int faces[2] = {m.loop_face[static_cast<std::size_t>(q_edge)], m.face_across[static_cast<std::size_t>(q_edge)]};
+    const double s0 = (rot * R * m.face_normals[static_cast<std::size_t>(faces[0])]).dot(s);
+    const double s1 = (rot * R * m.face_normals[static_cast<std::size_t>(faces[1])]).dot(s);
+    int f;
+    if (std::abs(s0 - s1) <= tiny)  // COM straight above the edge
+      f = faces[std::fmod(tiebreak * 4096.0, 1.0) < 0.5 ? 0 : 1];
+    else
+      f = s0 > s1 ? faces[0] : faces[1];
+    return roll_face(m, f, tiebreak, guard);
   }
-  return f;
+  return -1;
+}
+
+// 3. Face f flat on the floor. If it cannot hold the COM, the die turns about the point of the
+// face nearest the COM's foot: over that edge onto the face across, or about that corner.
+int roll_face(const DieModel& m, int f, double tiebreak, int& guard) {
+  while (guard-- > 0) {
+    const std::size_t fi = static_cast<std::size_t>(f);
+    if (m.face_hold[fi] >= 0.0) return f;
+    const Vec3& n = m.face_normals[fi];
+    const auto loop = m.face_vertices(f);
+    const int k = static_cast<int>(loop.size());
+    const Vec3 foot = n.dot(m.vertices[static_cast<std::size_t>(loop[0])]) * n;
+    double best = kInf, best_t = 0.0;
+    int best_k = 0;
+    for (int i = 0; i < k; ++i) {
+      const Vec3& A = m.vertices[static_cast<std::size_t>(loop[static_cast<std::size_t>(i)])];
+      const Vec3& B = m.vertices[static_cast<std::size_t>(loop[static_cast<std::size_t>((i + 1) % k)])];
+      const Vec3 ab = B - A;
+      const double t = std::clamp((foot - A).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+      const double d = (foot - (A + t * ab)).squaredNorm();
+      if (d < best) {
+        best = d;
+        best_t = t;
+        best_k = i;
+      }
+    }
+    constexpr double kEnd = 1e-9;
+    if (best_t > kEnd && best_t < 1.0 - kEnd) {
+      f = m.face_across[static_cast<std::size_t>(m.face_begin[fi] + best_k)];
+      continue;
+    }
+    const int corner = loop[static_cast<std::size_t>(best_t <= kEnd ? best_k : (best_k + 1) % k)];
+    const Mat3 R = Eigen::Quaterniond::FromTwoVectors(n, -Vec3::UnitZ()).toRotationMatrix();
+    return roll_vertex(m, R, corner, tiebreak, guard);
+  }
+  return -1;
 }
 
 }  // namespace
 
 void compute_rest_geometry(DieModel& m) {
-  m.max_escape = 0.0;
-  for (int f = 0; f < 6; ++f) {
-    const int a = f / 2, b = (a + 1) % 3, c = (a + 2) % 3;
-    const int plus = (f % 2 == 0) ? 1 : 0;
-    const int bits[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    for (int k = 0; k < 4; ++k) m.face_vertices[f][k] = (plus << a) | (bits[k][0] << b) | (bits[k][1] << c);
-    const Vec3& n = m.face_normals[f];
-    const double h = n.dot(m.vertices[m.face_vertices[f][0]]);
-    Vec3 centroid = Vec3::Zero();
-    for (int k = 0; k < 4; ++k) centroid += 0.25 * m.vertices[m.face_vertices[f][k]];
+  const int nf = m.face_count();
+  const std::size_t F = static_cast<std::size_t>(nf);
+  m.face_height.assign(F, 0.0);
+  m.face_hold.assign(F, 0.0);
+  m.face_escape.assign(F, kInf);
+  m.face_tip_ratio.assign(F, 0.0);
+  m.face_gyro.assign(F, 0.0);
+  m.face_area.assign(F, 0.0);
+  const Mat3 I = m.principal_moments.asDiagonal();
+  for (int f = 0; f < nf; ++f) {
+    const std::size_t fi = static_cast<std::size_t>(f);
+    const Vec3& n = m.face_normals[fi];
+    const auto loop = m.face_vertices(f);
+    const int k = static_cast<int>(loop.size());
+    const double h = n.dot(m.vertices[static_cast<std::size_t>(loop[0])]);
     const Vec3 foot = h * n;  // the COM's projection on the face plane
-    double escape = std::numeric_limits<double>::infinity(), tip = escape;
-    for (int k = 0; k < 4; ++k) {
-      const Vec3& A = m.vertices[m.face_vertices[f][k]];
-      const Vec3& B = m.vertices[m.face_vertices[f][(k + 1) % 4]];
-      const Vec3 e = (B - A).normalized();
-      escape = std::min(escape, A.cross(e).norm());
-      Vec3 inward = n.cross(e);
-      if ((centroid - A).dot(inward) < 0.0) inward = -inward;
-      tip = std::min(tip, (foot - A).dot(inward) / h);
+    double hold = kInf;
+    Vec3 area2 = Vec3::Zero();
+    for (int i = 0; i < k; ++i) {
+      const Vec3& A = m.vertices[static_cast<std::size_t>(loop[static_cast<std::size_t>(i)])];
+      const Vec3& B = m.vertices[static_cast<std::size_t>(loop[static_cast<std::size_t>((i + 1) % k)])];
+      const Vec3 inward = n.cross((B - A).normalized());  // counter-clockwise from outside
+      hold = std::min(hold, (foot - A).dot(inward));
+      area2 += A.cross(B);
     }
-    m.face_height[f] = h;
-    m.face_escape[f] = escape;
-    m.face_tip_ratio[f] = tip;  // < 0: the face cannot hold the COM (never for a box: COM inside)
-    m.max_escape = std::max(m.max_escape, escape);
+    m.face_height[fi] = h + m.rounding;
+    m.face_hold[fi] = hold;  // < 0: the face cannot hold the COM
+    m.face_tip_ratio[fi] = hold / (h + m.rounding);
+    m.face_gyro[fi] = n.cross(I * n).norm();
+    m.face_area[fi] = 0.5 * std::abs(area2.dot(n));
   }
+
+  // Saddles: every edge once (from the face whose loop has it, to the face across).
+  std::vector<int> basin(F);
+  for (int f = 0; f < nf; ++f) {
+    int guard = roll_guard(m);
+    basin[static_cast<std::size_t>(f)] = roll_face(m, f, 0.5, guard);
+  }
+  for (int f = 0; f < nf; ++f) {
+    const auto loop = m.face_vertices(f);
+    const int k = static_cast<int>(loop.size());
+    for (int i = 0; i < k; ++i) {
+      const int g = m.face_across[static_cast<std::size_t>(m.face_begin[static_cast<std::size_t>(f)] + i)];
+      if (g < f) continue;
+      const Vec3& A = m.vertices[static_cast<std::size_t>(loop[static_cast<std::size_t>(i)])];
+      const Vec3& B = m.vertices[static_cast<std::size_t>(loop[static_cast<std::size_t>((i + 1) % k)])];
+      const Vec3 ab = B - A;
+      const double t = (-A).dot(ab) / ab.squaredNorm();
+      if (t < 0.0 || t > 1.0) continue;  // the COM projects beyond the edge: no balance on it
+      const Vec3 w = -(A + t * ab);       // from the edge to the COM
+      // Balanced on the edge, the floor's normal -w/|w| must lie between the two face normals:
+      // -w = a n_f + b n_g with a, b >= 0 (all three are perpendicular to the edge).
+      const Vec3& nf_ = m.face_normals[static_cast<std::size_t>(f)];
+      const Vec3& ng = m.face_normals[static_cast<std::size_t>(g)];
+      const double c = nf_.dot(ng), d1 = -w.dot(nf_), d2 = -w.dot(ng);
+      const double det = 1.0 - c * c;
+      if (det <= 0.0) continue;
+      const double a = (d1 - c * d2) / det, b = (d2 - c * d1) / det;
+      const double tol = -1e-12 * w.norm();
+      if (a < tol || b < tol) continue;
+      const int bf = basin[static_cast<std::size_t>(f)], bg = basin[static_cast<std::size_t>(g)];
+      if (bf == bg || bf < 0 || bg < 0) continue;
+      const double height = w.norm() + m.rounding;
+      m.face_escape[static_cast<std::size_t>(bf)] = std::min(m.face_escape[static_cast<std::size_t>(bf)], height);
+      m.face_escape[static_cast<std::size_t>(bg)] = std::min(m.face_escape[static_cast<std::size_t>(bg)], height);
+    }
+  }
+  m.max_escape = 0.0;
+  bool any_finite = false;
+  for (double e : m.face_escape)
+    if (std::isfinite(e)) {
+      m.max_escape = std::max(m.max_escape, e);
+      any_finite = true;
+    }
+  if (!any_finite) m.max_escape = kInf;  // one basin only: every toss ends on it
 }
 
 int quasi_static_down_face(const DieModel& m, const Mat3& R, double tiebreak) {
-  Vec3 w[8];
   int p = 0;
-  for (int i = 0; i < 8; ++i) {
-    w[i] = R * m.vertices[i];
-    if (w[i].z() < w[p].z()) p = i;
-  }
-  const double tiny = 1e-12 * m.bounding_radius;
-
-  // 1. Pivot about corner p: the COM falls in the vertical plane through p and itself.
-  Vec3 dh(-w[p].x(), -w[p].y(), 0.0);  // horizontal COM offset from p
-  if (dh.norm() <= tiny) {             // COM straight above the corner: the toss decides the way
-    const double a = 2.0 * kPi * tiebreak;
-    dh = Vec3(std::cos(a), std::sin(a), 0.0);
-  }
-  const Vec3 axis = Vec3::UnitZ().cross(dh).normalized();
-  // The first theta in [0, pi] with A cos + B sin = 0 is atan2(A, -B); on [0, pi] the angle
-  // grows with -cos(theta) = B / hypot(A, B), so the smallest is found, and its cos and sin are
-  // known, without any trigonometric call.
-  int q = -1;
-  double key = std::numeric_limits<double>::infinity(), cos_t = 1.0, sin_t = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    const int j = p ^ (1 << k);
-    const Vec3 u = w[j] - w[p];
-    const double A = std::max(0.0, u.z()), B = axis.cross(u).z();
-    const double h = std::sqrt(A * A + B * B);
-    const double kk = h > 0.0 ? B / h : -1.0;  // (a degenerate edge: theta = 0)
-    if (kk < key) {
-      key = kk;
-      q = j;
-      cos_t = h > 0.0 ? -B / h : 1.0;
-      sin_t = h > 0.0 ? A / h : 0.0;
+  double low = kInf;
+  const int nv = m.vertex_count();
+  for (int i = 0; i < nv; ++i) {
+    const double z = R.row(2).dot(m.vertices[static_cast<std::size_t>(i)]);
+    if (z < low) {
+      low = z;
+      p = i;
     }
   }
-  // Rodrigues: rot = cos I + sin [axis]x + (1 - cos) axis axis^T.
-  Mat3 cross_axis;
-  cross_axis << 0.0, -axis.z(), axis.y(), axis.z(), 0.0, -axis.x(), -axis.y(), axis.x(), 0.0;
-  const Mat3 rot = cos_t * Mat3::Identity() + sin_t * cross_axis + (1.0 - cos_t) * (axis * axis.transpose());
+  int guard = roll_guard(m);
+  return roll_vertex(m, R, p, tiebreak, guard);
+}
 
-  // 2. Tip about edge p-q toward the side of the COM.
-  const Vec3 c = rot * (-w[p]);
-  const Vec3 e = (rot * (w[q] - w[p])).normalized();
-  Vec3 s = c - c.dot(e) * e;
-  s.z() = 0.0;
-  const int k = __builtin_ctz(static_cast<unsigned>(p ^ q));
-  int faces[2], nf = 0;
-  for (int ax = 0; ax < 3 && nf < 2; ++ax)
-    if (ax != k) faces[nf++] = 2 * ax + (((p >> ax) & 1) ? 0 : 1);
-  const double s0 = (rot * R * m.face_normals[faces[0]]).dot(s);
-  const double s1 = (rot * R * m.face_normals[faces[1]]).dot(s);
-  int f;
-  if (std::abs(s0 - s1) <= tiny)  // COM straight above the edge
-    f = faces[std::fmod(tiebreak * 4096.0, 1.0) < 0.5 ? 0 : 1];
-  else
-    f = s0 > s1 ? faces[0] : faces[1];
-
-  // 3. A face that cannot hold the COM tips over its worst edge (never happens for a box).
-  for (int guard = 0; guard < 6 && m.face_tip_ratio[f] < 0.0; ++guard) {
-    const Vec3 foot = m.face_height[f] * m.face_normals[f];
-    int best = 0;
-    double worst = std::numeric_limits<double>::infinity();
-    for (int j = 0; j < 4; ++j) {
-      const Vec3& A = m.vertices[m.face_vertices[f][j]];
-      const Vec3& B = m.vertices[m.face_vertices[f][(j + 1) % 4]];
-      Vec3 inward = m.face_normals[f].cross((B - A).normalized());
-      Vec3 centroid = Vec3::Zero();
-      for (int i = 0; i < 4; ++i) centroid += 0.25 * m.vertices[m.face_vertices[f][i]];
-      if ((centroid - A).dot(inward) < 0.0) inward = -inward;
-      const double d = (foot - A).dot(inward);
-      if (d < worst) {
-        worst = d;
-        best = j;
-      }
-    }
-    f = face_across(f, m.face_vertices[f][best], m.face_vertices[f][(best + 1) % 4]);
-  }
-  return f;
+int roll_from_face(const DieModel& m, int f, double tiebreak) {
+  int guard = roll_guard(m);
+  return roll_face(m, f, tiebreak, guard);
 }
 
 int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) {
@@ -133,36 +225,40 @@ int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) {
   const double mg = m.mass * m.gravity;
   if (ke + mg * s.position.z() >= mg * m.max_escape) return -1;  // cheap: no basin can hold it yet
 
-  double low = std::numeric_limits<double>::infinity();
+  double low = kInf;
   for (const Vec3& v : m.vertices) low = std::min(low, s.R.row(2).dot(v));
-  low += s.position.z();
+  low += s.position.z() - m.rounding;
   const double energy = ke + mg * (s.position.z() + std::max(0.0, -low));
 
   // Lying flat on the face most nearly down, sliding or spinning but not rocking.
   int down = 0;
   double down_z = 2.0;
-  for (int f = 0; f < 6; ++f) {
-    const double z = s.R.row(2).dot(m.face_normals[f]);
+  const int nf = m.face_count();
+  for (int f = 0; f < nf; ++f) {
+    const double z = s.R.row(2).dot(m.face_normals[static_cast<std::size_t>(f)]);
     if (z < down_z) {
       down_z = z;
       down = f;
     }
   }
+  const std::size_t di = static_cast<std::size_t>(down);
   const double flat_tol = 1e-6 * m.bounding_radius;
   const double v_tol = 1e-3 * std::sqrt(m.gravity * m.bounding_radius);
-  if (low <= flat_tol && m.max_friction < 0.999 * m.face_tip_ratio[down] && down_z < -0.999) {
+  const double spin = s.omega.z();
+  if (low <= flat_tol && m.max_friction < 0.999 * m.face_tip_ratio[di] && down_z < -0.999 &&
+      spin * spin * m.face_gyro[di] < 0.999 * mg * m.face_hold[di]) {
     bool flat = true;
-    for (int k = 0; k < 4 && flat; ++k) {
-      const int v = m.face_vertices[down][k];
-      const Vec3 r = s.R * m.vertices[v];
-      flat = s.position.z() + r.z() - std::min(low, 0.0) <= flat_tol &&
+    for (const int v : m.face_vertices(down)) {
+      if (!flat) break;
+      const Vec3 r = s.R * m.vertices[static_cast<std::size_t>(v)];
+      flat = s.position.z() + r.z() - m.rounding - std::min(low, 0.0) <= flat_tol &&
              std::abs((s.velocity + s.omega.cross(r)).z()) <= v_tol;
     }
     if (flat) return down;
   }
 
   const int basin = quasi_static_down_face(m, s.R, tiebreak);
-  if (energy < mg * m.face_escape[basin] * (1.0 - 1e-9)) return basin;
+  if (basin >= 0 && energy < mg * m.face_escape[static_cast<std::size_t>(basin)] * (1.0 - 1e-9)) return basin;
   return -1;
 }
 

@@ -14,23 +14,39 @@
 
 namespace dicesim {
 
-// Fills the face_* fields of a model whose vertices, face normals and frictions are set.
+// Fills the face_* fields and max_escape of a model whose vertices, faces (loops, normals,
+// across), adjacency, frictions, rounding and principal moments are set. The basin barrier
+// face_escape[B] is the lowest saddle on the boundary of B's basin: the die balanced on an edge
+// with its COM straight above it (a critical point of the COM height only where the COM projects
+// inside the edge and the vertical lies between the edge's two face normals), height = distance
+// from the COM to the edge + rounding, separating the basins the two sides roll to.
 void compute_rest_geometry(DieModel& m);
 
 // Quasi-static roll from orientation R (body -> world) standing on its lowest corner: pivot about
-// that corner in the plane of steepest descent until an edge touches, tip about the edge toward the
-// COM until a face touches, then over an edge while the face cannot hold the COM. Returns the face
-// index (0..5) that ends down. `tiebreak` in [0, 1) decides exact balances (COM straight above the
-// corner or the edge): derived from the toss index by the caller, never from hidden randomness.
+// that corner in the vertical plane through it and the COM until an edge touches (steepest
+// descent of the COM), then tip about the edge toward the COM until a face touches (or, if the COM
+// projects beyond the edge's far end, pivot on that corner), then, while the face cannot hold the
+// COM, over the edge (or pivot about the corner) of the face nearest the COM's foot. Returns the
+// face index that ends down (always a face that holds the COM), or -1 if the roll did not end
+// within its step guard (never seen; the caller counts it). `tiebreak` in [0, 1) decides exact
+// balances (COM straight above the corner or the edge): derived from the toss index by the caller.
+// Only the down direction R^T (-z) matters, so for a uniform orientation each face's probability
+// is the area of its basin on the Gauss map over 4 pi.
 int quasi_static_down_face(const DieModel& m, const Mat3& R, double tiebreak);
+
+// The same roll starting with face f flat on the floor (f itself if it holds the COM).
+int roll_from_face(const DieModel& m, int f, double tiebreak);
 
 // The face (index) the die must come to rest on, or -1 while it is still undecided:
 //  - energy: E < m g face_escape[A] with A = the basin of R (above); or
-//  - lying flat: the four corners of A on the floor with vanishing normal velocity and every
-//    corner's friction below face_tip_ratio[A], so friction cannot tip it while it slides/spins.
+//  - lying flat: every corner of the face most nearly down, A, on the floor with vanishing normal
+//    velocity; every corner's friction below face_tip_ratio[A], so friction cannot tip it while it
+//    slides or spins; and the spin w about the vertical small enough that the torque keeping a
+//    non-principal axis upright, w^2 |n x I n|, is within what gravity holds, m g face_hold[A]
+//    (beyond that the spinning die lifts an edge). A face that cannot hold the COM never qualifies.
 int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak);
 
-// The face opposite face index f (order +x, -x, +y, -y, +z, -z).
-inline int opposite_face(int f) { return f ^ 1; }
+// The face that is read when face f lies on the floor (the face up, or f for a die read down).
+inline int result_face(const DieModel& m, int f) { return m.face_result[static_cast<std::size_t>(f)]; }
 
 }  // namespace dicesim

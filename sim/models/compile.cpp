@@ -2,8 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "sim/body/body.hpp"
 #include "sim/models/fidelity_auto.hpp"
 #include "sim/dynamics/rest.hpp"
 #include "sim/scene/scene_error.hpp"
@@ -12,92 +17,134 @@
 namespace dicesim {
 namespace {
 
-std::string region_key(std::size_t k) { return "die.regions[" + std::to_string(k) + "]"; }
-
 std::string fmt(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.6g", v);
   return buf;
 }
 
-// Regions must each cover some of the box and must not overlap: the density field is then
-// unambiguous, and mass properties are the exact sum over regions.
-void check_regions(const DieDef& die, const std::string& origin) {
-  const double box_volume = die.size.prod();
-  const double tiny = 1e-9 * box_volume;
-  for (std::size_t k = 0; k < die.regions.size(); ++k) {
-    if (clipped_box_moments(die.size, die.regions[k].half_spaces).volume <= tiny)
-      throw SceneError(origin, region_key(k) + ".cuts", "", "the cuts leave no part of the die for this region");
-    for (std::size_t j = 0; j < k; ++j) {
-      std::vector<HalfSpace> both = die.regions[j].half_spaces;
-      both.insert(both.end(), die.regions[k].half_spaces.begin(), die.regions[k].half_spaces.end());
-      if (clipped_box_moments(die.size, both).volume > tiny)
-        throw SceneError(origin, region_key(k) + ".cuts", "",
-                         "overlaps " + region_key(j) + "; regions must not overlap");
+
+// Corner adjacency, edge positions and the face across every edge, from the face loops. A loop
+// edge a -> b must meet exactly one b -> a in another face (a closed, consistently oriented hull).
+void build_topology(DieModel& m, const ConvexShape& shape, const std::string& origin, const std::string& kind) {
+  const int nv = static_cast<int>(shape.vertices.size());
+  m.face_begin.assign(1, 0);
+  m.face_loop.clear();
+  m.loop_face.clear();
+  for (std::size_t f = 0; f < shape.faces.size(); ++f) {
+    if (shape.faces[f].size() < 3)
+      throw SceneError(origin, "die.shape", kind, "a face with fewer than 3 corners");
+    for (const int v : shape.faces[f]) {
+      if (v < 0 || v >= nv) throw SceneError(origin, "die.shape", kind, "a face refers to a missing corner");
+      m.face_loop.push_back(v);
+      m.loop_face.push_back(static_cast<int>(f));
     }
+    m.face_begin.push_back(static_cast<int>(m.face_loop.size()));
+  }
+  std::map<std::pair<int, int>, int> edge_pos;  // directed edge -> loop position
+  for (std::size_t f = 0; f < shape.faces.size(); ++f) {
+    const int b0 = m.face_begin[f], k = m.face_begin[f + 1] - b0;
+    for (int i = 0; i < k; ++i) {
+      const int a = m.face_loop[static_cast<std::size_t>(b0 + i)];
+      const int b = m.face_loop[static_cast<std::size_t>(b0 + (i + 1) % k)];
+      if (!edge_pos.emplace(std::make_pair(a, b), b0 + i).second)
+        throw SceneError(origin, "die.shape", kind, "two faces share an edge in the same direction (not a consistently oriented hull)");
+    }
+  }
+  m.face_across.assign(m.face_loop.size(), -1);
+  std::vector<std::vector<std::pair<int, int>>> adj(static_cast<std::size_t>(nv));  // (neighbour, edge position)
+  for (const auto& [ab, pos] : edge_pos) {
+    const auto it = edge_pos.find({ab.second, ab.first});
+    if (it == edge_pos.end())
+      throw SceneError(origin, "die.shape", kind, "an edge belongs to one face only (the hull is not closed)");
+    m.face_across[static_cast<std::size_t>(pos)] = m.loop_face[static_cast<std::size_t>(it->second)];
+    adj[static_cast<std::size_t>(ab.first)].push_back({ab.second, pos});
+  }
+  m.vertex_adj_begin.assign(1, 0);
+  m.vertex_adj.clear();
+  m.vertex_adj_edge.clear();
+  for (auto& list : adj) {
+    std::sort(list.begin(), list.end());
+    for (const auto& [j, pos] : list) {
+      m.vertex_adj.push_back(j);
+      m.vertex_adj_edge.push_back(pos);
+    }
+    m.vertex_adj_begin.push_back(static_cast<int>(m.vertex_adj.size()));
   }
 }
 
-// A corner's material: the volume-weighted mix of the materials in a small cube at that corner
-// (a cut through a corner, as the seed's Die 3 has, gives a mix instead of an arbitrary pick).
-void corner_materials(const DieDef& die, const std::map<std::string, MaterialDef>& materials, int corner,
-                      double& restitution, double& friction) {
-  const Vec3 half = 0.5 * die.size;
-  const double eps = 1e-6 * die.size.minCoeff();
-  Vec3 lo, hi;
-  for (int a = 0; a < 3; ++a) {
-    const bool plus = (corner >> a) & 1;
-    lo[a] = plus ? half[a] - eps : -half[a];
-    hi[a] = plus ? half[a] : -half[a] + eps;
+// Outcomes: distinct labels ascending; the face read when each face lies on the floor.
+void build_outcomes(DieModel& m) {
+  m.outcome_labels = m.face_labels;
+  std::sort(m.outcome_labels.begin(), m.outcome_labels.end());
+  m.outcome_labels.erase(std::unique(m.outcome_labels.begin(), m.outcome_labels.end()), m.outcome_labels.end());
+  const int nf = m.face_count();
+  m.face_outcome.resize(static_cast<std::size_t>(nf));
+  m.face_result.resize(static_cast<std::size_t>(nf));
+  for (int f = 0; f < nf; ++f) {
+    const std::size_t fi = static_cast<std::size_t>(f);
+    m.face_outcome[fi] = static_cast<int>(
+        std::lower_bound(m.outcome_labels.begin(), m.outcome_labels.end(), m.face_labels[fi]) - m.outcome_labels.begin());
+    if (m.read_down) {
+      m.face_result[fi] = f;
+      continue;
+    }
+    int up = f;
+    double best = 2.0;
+    for (int g = 0; g < nf; ++g) {
+      const double z = m.face_normals[fi].dot(m.face_normals[static_cast<std::size_t>(g)]);
+      if (z < best) {
+        best = z;
+        up = g;
+      }
+    }
+    m.face_result[fi] = up;
   }
-  const double v = (hi - lo).prod();
-  double base_fraction = 1.0;
-  restitution = friction = 0.0;
-  for (const RegionDef& r : die.regions) {
-    const double f = clipped_aabb_moments(lo, hi, r.half_spaces).volume / v;
-    if (f <= 0.0) continue;
-    base_fraction -= f;
-    restitution += f * materials.at(r.material).restitution;
-    friction += f * materials.at(r.material).friction;
-  }
-  base_fraction = std::max(0.0, base_fraction);
-  restitution += base_fraction * materials.at(die.base_material).restitution;
-  friction += base_fraction * materials.at(die.base_material).friction;
 }
 
 }  // namespace
 
 DieModel compile(const SceneDef& scene, const std::string& origin) {
-  const DieDef& die = scene.die;
-  check_regions(die, origin);
+  return compile_body(build_body(scene, origin), scene, origin);
+}
+
+DieModel compile_body(const Body& body, const SceneDef& scene, const std::string& origin) {
+  const ConvexShape& shape = body.shape;
+  const std::size_t nv = shape.vertices.size(), nf = shape.faces.size();
+  if (nv < 4 || nf < 4 || shape.normals.size() != nf || body.face_labels.size() != nf ||
+      body.vertex_restitution.size() != nv || body.vertex_friction.size() != nv)
+    throw SceneError(origin, "die.shape", body.kind, "the body is incomplete (corners, faces, normals, labels or materials missing)");
 
   DieModel m;
   m.name = scene.name;
-  m.mass_geometric = compute_mass_properties(die, scene.materials);
+  m.kind = body.kind;
+  m.convex = body.convex;
+  m.read_down = body.read_down;
+  m.rounding = shape.rounding;
+  m.mass_geometric = body.mass;
   const MassProperties& mp = m.mass_geometric;
-  if (!(mp.mass > 0.0) || !mp.inertia.allFinite())
-    throw SceneError(origin, "die", "", "the die has no mass; check die.size and the densities");
 
   m.mass = mp.mass;
   m.principal_moments = mp.principal_moments;
   m.geo_to_body = mp.principal_axes.transpose();
   m.symmetric_top = is_symmetric_top(m.principal_moments);
 
-  const Vec3 half = 0.5 * die.size;
-  for (int c = 0; c < 8; ++c) {
-    Vec3 corner;
-    for (int a = 0; a < 3; ++a) corner[a] = ((c >> a) & 1) ? half[a] : -half[a];
-    m.vertices[c] = m.geo_to_body * (corner - mp.com);
-    corner_materials(die, scene.materials, c, m.vertex_restitution[c], m.vertex_friction[c]);
-    if (scene.floor.restitution) m.vertex_restitution[c] = *scene.floor.restitution;
-    m.bounding_radius = std::max(m.bounding_radius, m.vertices[c].norm());
+  m.vertices.resize(nv);
+  m.vertex_restitution.resize(nv);
+  m.vertex_friction.resize(nv);
+  double reach = 0.0;
+  for (std::size_t c = 0; c < nv; ++c) {
+    m.vertices[c] = m.geo_to_body * (shape.vertices[c] - mp.com);
+    m.vertex_restitution[c] = scene.floor.restitution ? *scene.floor.restitution : body.vertex_restitution[c];
+    m.vertex_friction[c] = body.vertex_friction[c];
+    reach = std::max(reach, m.vertices[c].norm());
   }
-  for (int f = 0; f < 6; ++f) {
-    Vec3 n = Vec3::Zero();
-    n[f / 2] = (f % 2 == 0) ? 1.0 : -1.0;
-    m.face_normals[f] = m.geo_to_body * n;
-  }
-  m.face_labels = die.face_labels;
+  m.bounding_radius = reach + m.rounding;
+  m.face_normals.resize(nf);
+  m.face_labels = body.face_labels;
+  for (std::size_t f = 0; f < nf; ++f) m.face_normals[f] = m.geo_to_body * shape.normals[f];
+  build_topology(m, shape, origin, body.kind);
+  build_outcomes(m);
 
   compute_rest_geometry(m);
   m.max_friction = *std::max_element(m.vertex_friction.begin(), m.vertex_friction.end());
@@ -118,7 +165,7 @@ DieModel compile(const SceneDef& scene, const std::string& origin) {
     const Vec3 e = scene.throw_.orientation.euler_deg * (kPi / 180.0);
     const Mat3 R = euler_zxz(e.x(), e.y(), e.z()) * m.geo_to_body.transpose();
     double depth = 0.0;
-    for (const Vec3& v : m.vertices) depth = std::max(depth, -(R * v).z());
+    for (const Vec3& v : m.vertices) depth = std::max(depth, -(R * v).z() + m.rounding);
     if (h.mean < depth - 1e-12 * m.bounding_radius)
       throw SceneError(origin, "throw.height.mean", fmt(h.mean),
                        "the die starts below the floor: in this orientation the COM must be at least " +

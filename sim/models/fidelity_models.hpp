@@ -3,6 +3,8 @@
 // decides exact balances (PHYSICS.md, erratum 9: no hidden randomness).
 #pragma once
 
+#include <vector>
+
 #include "sim/body/die_model.hpp"
 #include "sim/dynamics/flight.hpp"
 #include "sim/models/toss.hpp"
@@ -11,6 +13,13 @@ namespace dicesim {
 
 // `static`: the initial orientation, then the quasi-static roll (sim/rest.hpp). No dynamics.
 TossResult run_static(const DieModel& m, const RigidState& s, double tiebreak);
+
+// `static` over a uniform orientation, deterministically: the share of `directions` down
+// directions on a Fibonacci lattice of the sphere that roll to each face, as the probability of
+// each face (index) being the one read. For a uniform orientation each face's basin area on the
+// Gauss map over 4 pi; the lattice's error is about 1 / directions (a basin boundary's length
+// times the spacing).
+std::vector<double> static_face_probabilities(const DieModel& m, int directions);
 
 // `impulse`: exact flight (sim/flight.hpp) between impacts with the friction impact law
 // (sim/friction_impact.hpp); sustained contact by fixed steps of m.contact_step

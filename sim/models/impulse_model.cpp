@@ -23,6 +23,7 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
   bool after_impact = false;  // the state is right after an impact (sustained contact is possible)
   StepperStats stats;
   const auto finish = [&](TossStatus status) {
+    if (probe && probe->final_state) *probe->final_state = s;
     r.status = status;
     r.t_end = t;
     r.corrections.add(stats.corrections);
@@ -35,8 +36,7 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
     return r;
   };
   const auto settle = [&](int down) {
-    r.face_index = opposite_face(down);
-    r.face = m.face_labels[r.face_index];
+    set_result_face(m, result_face(m, down), r);
     return finish(TossStatus::Settled);
   };
   for (;;) {

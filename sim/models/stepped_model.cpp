@@ -19,6 +19,7 @@ TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossPro
     probe->located_steps += stats.located;
     probe->max_energy_gain = std::max(probe->max_energy_gain, stats.max_energy_gain);
   }
+  if (probe && probe->final_state) *probe->final_state = s;
   r.corrections = stats.corrections;
   r.bounces = impacts;
   r.t_end = t;
@@ -27,8 +28,7 @@ TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossPro
     return r;
   }
   r.status = TossStatus::Settled;
-  r.face_index = opposite_face(o.face_down);
-  r.face = m.face_labels[r.face_index];
+  set_result_face(m, result_face(m, o.face_down), r);
   return r;
 }
 

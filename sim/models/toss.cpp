@@ -37,7 +37,7 @@ bool starts_valid(const DieModel& m, const RigidState& s) {
   if (!s.position.allFinite() || !s.velocity.allFinite() || !s.omega.allFinite() || !s.R.allFinite()) return false;
   const double tol = 1e-9 * m.bounding_radius;
   for (const Vec3& v : m.vertices)
-    if (s.position.z() + s.R.row(2).dot(v) < -tol) return false;
+    if (s.position.z() + s.R.row(2).dot(v) - m.rounding < -tol) return false;
   return true;
 }
 
@@ -81,8 +81,7 @@ TossResult run_paper(const DieModel& m, RigidState s, TossProbe* probe) {
     // The seed's rule: the toss is over when the COM's rebound speed is below the threshold.
     if (s.velocity.z() < m.stop_speed) {
       r.status = TossStatus::Settled;
-      r.face_index = top_face_index(m, s.R);
-      r.face = m.face_labels[r.face_index];
+      set_result_face(m, read_face_index(m, s.R), r);
       r.t_end = t_now;
       return r;
     }

@@ -20,12 +20,20 @@ const char* to_string(TossStatus s);
 
 struct TossResult {
   int face = 0;        // face label (settled tosses), else 0
-  int face_index = -1; // 0..5 in +x, -x, +y, -y, +z, -z order, else -1
+  int face_index = -1; // the face read, in the model's face order (a box: +x, -x, +y, -y, +z, -z), else -1
+  int outcome = -1;    // index of `face` in the model's outcome_labels (label order), else -1
   TossStatus status = TossStatus::Invalid;
   int bounces = 0;
   double t_end = 0.0;  // simulated time at the end (s)
   Corrections corrections;  // guards and fallbacks that fired during the toss (should all be 0)
 };
+
+// Records face index f as the result read (label and outcome from the model).
+inline void set_result_face(const DieModel& m, int f, TossResult& r) {
+  r.face_index = f;
+  r.face = m.face_labels[static_cast<std::size_t>(f)];
+  r.outcome = m.face_outcome[static_cast<std::size_t>(f)];
+}
 
 // One impact, for traces and replays.
 struct BounceRecord {
@@ -52,6 +60,7 @@ struct TossProbe {
   std::uint64_t steps = 0;
   std::uint64_t located_steps = 0;  // fixed steps shortened to the instant a new corner touches
   double max_energy_gain = 0.0;
+  RigidState* final_state = nullptr;           // impulse, stepped: the state when the toss ended
 };
 
 // Chatter guard (`paper`): this many impacts in a row, each less than kZenoInterval after the

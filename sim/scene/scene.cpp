@@ -313,9 +313,110 @@ std::string material_ref(Reader& r, const std::map<std::string, MaterialDef>& ma
   return *name;
 }
 
+constexpr Range kScale{.lo = 0, .hi = 1e6, .lo_open = true};
+constexpr Range kRounding{.lo = 0, .hi = 100, .hi_open = true, .unit = "m"};
+constexpr Range kCoordinate{.lo = -1e6, .hi = 1e6};  // times die.scale: metres
+constexpr Names<bool, 2> kReadSides{{{"up", false}, {"down", true}}};  // value: read_down
+
+constexpr bool is_preset(ShapeKind k) {
+  return k == ShapeKind::D4 || k == ShapeKind::D6 || k == ShapeKind::D8 || k == ShapeKind::D10 ||
+         k == ShapeKind::D12 || k == ShapeKind::D20;
+}
+
+// The OBJ file a mesh die names, read now (relative to the file the key was written in), so that
+// the SceneDef alone describes the die.
+void read_mesh_file(Reader& die, DieDef& def) {
+  const toml::node* n = die.get("mesh");
+  const fs::path written = n->as_string()->get();
+  const fs::path base = n->source().path ? fs::path(*n->source().path).parent_path() : fs::current_path();
+  const fs::path path = written.is_absolute() ? written : (base / written).lexically_normal();
+  std::ifstream in(path, std::ios::binary);
+  if (!in || fs::is_directory(path))
+    die.fail(n, die.path_of("mesh"), "cannot open mesh file '" + path.string() + "' (a Wavefront OBJ path relative to the scene file)");
+  std::ostringstream text;
+  text << in.rdbuf();
+  def.mesh = written.string();
+  def.mesh_path = path.string();
+  def.mesh_text = text.str();
+}
+
 void read_die(Reader die, const std::map<std::string, MaterialDef>& materials, DieDef& def) {
-  def.size = die.vec3("size", kEdge, def.size, true);
+  {
+    const std::optional<std::string> name = die.string("shape");
+    if (name) {
+      const auto it = std::find(kShapeNames.begin(), kShapeNames.end(), *name);
+      if (it == kShapeNames.end()) {
+        std::string allowed;
+        for (const char* k : kShapeNames) allowed += (allowed.empty() ? "" : ", ") + toml_string(k);
+        die.fail(die.get("shape"), die.path_of("shape"), "must be one of: " + allowed);
+      }
+      def.shape = static_cast<ShapeKind>(it - kShapeNames.begin());
+    }
+  }
+  const ShapeKind kind = def.shape;
+  const std::string shape_text = std::string("shape = \"") + kShapeNames[static_cast<int>(kind)] + "\"";
+  // A key that the shape does not use is an error, not silently ignored.
+  auto only_for = [&](std::string_view key, bool applies, const char* which) {
+    if (const toml::node* n = die.get(key); n && !applies)
+      die.fail(n, die.path_of(key), "does not apply to " + shape_text + "; it is for " + which);
+  };
+  only_for("size", kind == ShapeKind::Box || is_preset(kind), "shape = \"box\" and the presets d4..d20");
+  only_for("sides", kind == ShapeKind::Prism, "shape = \"prism\"");
+  only_for("radius", kind == ShapeKind::Prism, "shape = \"prism\"");
+  only_for("length", kind == ShapeKind::Prism, "shape = \"prism\"");
+  only_for("vertices", kind == ShapeKind::Hull, "shape = \"hull\"");
+  only_for("mesh", kind == ShapeKind::Mesh, "shape = \"mesh\"");
+  only_for("scale", kind == ShapeKind::Hull || kind == ShapeKind::Mesh, "shape = \"hull\" and \"mesh\"");
+  only_for("faces", kind == ShapeKind::Box || kind == ShapeKind::D6, "shape = \"box\" and \"d6\"; use [[die.labels]]");
+  only_for("rounding", kind != ShapeKind::Mesh, "every shape but \"mesh\" (round the mesh itself)");
+
+  if (kind == ShapeKind::Box) {
+    def.size = die.vec3("size", kEdge, def.size, true);
+  } else if (is_preset(kind)) {
+    const toml::node* n = die.get("size");
+    if (n && !(n->is_integer() || n->is_floating_point()))
+      die.fail(n, die.path_of("size"), "must be a number for " + shape_text + ": the distance between opposite faces" +
+                                           (kind == ShapeKind::D4 ? " (d4: from a face to the opposite vertex)" : "") +
+                                           kEdge.text());
+    def.size = Vec3::Constant(die.number("size", kEdge, def.size.x()));
+  } else if (kind == ShapeKind::Prism) {
+    def.sides = die.integer("sides", 3, 1000, def.sides);
+    def.radius = die.number("radius", kEdge, def.radius);
+    def.length = die.number("length", kEdge, def.length);
+  } else if (kind == ShapeKind::Hull) {
+    const toml::node* n = die.get("vertices");
+    if (!n) die.fail_missing("vertices", "an array of at least 4 points [x, y, z] (m), not all in one plane");
+    const auto* a = n->as_array();
+    if (!a || a->size() < 4)
+      die.fail(n, die.path_of("vertices"), "must be an array of at least 4 points [x, y, z] (m), not all in one plane");
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const std::string k = die.path_of("vertices") + "[" + std::to_string(i) + "]";
+      const auto* p = a->get(i)->as_array();
+      if (!p || p->size() != 3) die.fail(a->get(i), k, "must be an array of 3 numbers" + kCoordinate.text());
+      Vec3 v;
+      for (int c = 0; c < 3; ++c) v[c] = die.number(*p->get(c), k + "[" + std::to_string(c) + "]", kCoordinate);
+      def.vertices.push_back(v);
+    }
+  } else if (kind == ShapeKind::Mesh) {
+    if (!die.string("mesh")) die.fail_missing("mesh", "the path of a Wavefront OBJ file, relative to the scene file");
+    read_mesh_file(die, def);
+  }
+  def.scale = die.number("scale", kScale, def.scale);
+  def.rounding = die.number("rounding", kRounding, def.rounding);
+  if (die.get("read")) def.read_down = die.choice("read", kReadSides, false).second;
+
   def.base_material = material_ref(die, materials);
+  for (Reader& label : die.tables("labels")) {
+    LabelDef ld;
+    const toml::node* normal = label.get("normal");
+    if (!normal) label.fail_missing("normal", "an array of 3 numbers, not all 0: the face's outward direction");
+    ld.normal = label.vec3("normal", kAnyNumber, ld.normal, false);
+    if (ld.normal.isZero(0.0)) label.fail(normal, label.path_of("normal"), "must be an array of 3 numbers, not all 0");
+    if (!label.get("label")) label.fail_missing("label", "an integer in [0, 999]");
+    ld.label = label.integer("label", 0, 999, ld.label);
+    label.finish();
+    def.labels.push_back(ld);
+  }
   for (Reader& region : die.tables("regions")) {
     RegionDef rd;
     rd.material = material_ref(region, materials);

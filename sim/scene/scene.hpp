@@ -19,13 +19,14 @@ struct MaterialDef {
   double friction = 0.3;      // Coulomb coefficient against the floor, [0, 10]
 };
 
-// Half-space {x : normal . x <= offset} in the die's geometric frame (origin at the box centre, m).
+// Half-space {x : normal . x <= offset} in the die's geometric frame (m): origin at the centre for a
+// box, preset or prism; the coordinates as given for a hull or mesh.
 struct HalfSpace {
   Vec3 normal = Vec3::UnitZ();
   double offset = 0.0;
 };
 
-// A convex region of the box: the box intersected with every half-space listed.
+// A convex region of the die: the die intersected with every half-space listed.
 // Regions must not overlap; what no region covers is made of DieDef::base_material.
 struct RegionDef {
   std::string material;
@@ -36,12 +37,39 @@ struct RegionDef {
 enum class FaceDir { PosX = 0, NegX = 1, PosY = 2, NegY = 3, PosZ = 4, NegZ = 5 };
 inline constexpr std::array<const char*, 6> kFaceDirNames = {"+x", "-x", "+y", "-y", "+z", "-z"};
 
+// The kinds of die (die.shape). Box is today's six-faced box; the presets are the regular solids
+// (d10: the pentagonal trapezohedron); prism: a regular n-gon prism; hull: the convex hull of
+// listed points; mesh: a closed Wavefront OBJ (contact on its hull, mass from the mesh itself).
+enum class ShapeKind { Box, D4, D6, D8, D10, D12, D20, Prism, Hull, Mesh };
+inline constexpr std::array<const char*, 10> kShapeNames = {"box", "d4",  "d6",    "d8",   "d10",
+                                                            "d12", "d20", "prism", "hull", "mesh"};
+
+// [[die.labels]]: the face whose outward normal is nearest `normal` gets `label`.
+struct LabelDef {
+  Vec3 normal = Vec3::UnitZ();
+  int label = 1;
+};
+
 struct DieDef {
-  Vec3 size = Vec3(0.03, 0.03, 0.03);  // edge lengths along x, y, z (m)
+  ShapeKind shape = ShapeKind::Box;
+  // box: edge lengths along x, y, z (m). d4..d20: size.x() is the distance between opposite faces
+  // (d4: from a face to the opposite vertex); the scene gives it as one number.
+  Vec3 size = Vec3(0.03, 0.03, 0.03);
+  int sides = 3;                       // prism: number of sides of the regular n-gon, >= 3
+  double radius = 0.01;                // prism: circumradius of the n-gon (m)
+  double length = 0.05;                // prism: length along z (m)
+  std::vector<Vec3> vertices;          // hull: the points whose convex hull is the die (m)
+  std::string mesh;                    // mesh: the OBJ path as written in the scene
+  std::string mesh_path;               // mesh: that path resolved against the scene file's folder
+  std::string mesh_text;               // mesh: the OBJ file's text, read when the scene is loaded
+  double scale = 1.0;                  // hull, mesh: coordinates are multiplied by this (e.g. 0.001 for mm)
+  double rounding = 0.0;               // radius of the rounded edges and corners (m), below the inradius
+  std::optional<bool> read_down;       // read = "down" / "up"; unset: the shape's default (d4 down)
+  std::vector<LabelDef> labels;        // [[die.labels]], applied after the shape's own labels
   std::string base_material;           // required
   std::vector<RegionDef> regions;      // optional cuts of other materials
-  // Label of the face whose outward normal is +x, -x, +y, -y, +z, -z (a standard die by default:
-  // 1 up on +z, opposite faces sum to 7).
+  // Box (and d6): label of the face whose outward normal is +x, -x, +y, -y, +z, -z (a standard die
+  // by default: 1 up on +z, opposite faces sum to 7).
   std::array<int, 6> face_labels = {2, 5, 3, 4, 1, 6};
 };
 

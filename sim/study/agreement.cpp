@@ -1,6 +1,7 @@
 #include "sim/study/agreement.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include <boost/math/distributions/chi_squared.hpp>
 
@@ -8,16 +9,18 @@
 
 namespace dicesim {
 
-Agreement agreement_of(const std::array<std::uint64_t, 6>& a, const std::array<std::uint64_t, 6>& b) {
+Agreement agreement_of(std::span<const std::uint64_t> a, std::span<const std::uint64_t> b) {
+  if (a.size() != b.size()) throw std::invalid_argument("agreement_of: different numbers of outcomes");
+  const std::size_t n = a.size();
   Agreement out;
   double na = 0.0, nb = 0.0;
-  for (int f = 0; f < 6; ++f) {
+  for (std::size_t f = 0; f < n; ++f) {
     na += static_cast<double>(a[f]);
     nb += static_cast<double>(b[f]);
   }
   if (na == 0.0 || nb == 0.0) return out;
   int cells = 0;
-  for (int f = 0; f < 6; ++f) {
+  for (std::size_t f = 0; f < n; ++f) {
     const double pa = a[f] / na, pb = b[f] / nb;
     out.tv += 0.5 * std::abs(pa - pb);
     const double col = static_cast<double>(a[f] + b[f]);

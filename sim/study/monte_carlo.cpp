@@ -11,7 +11,8 @@ void RunCounts::add(const TossResult& r) {
   switch (r.status) {
     case TossStatus::Settled:
       ++settled;
-      ++faces[static_cast<std::size_t>(r.face_index)];
+      if (static_cast<std::size_t>(r.outcome) >= faces.size()) faces.resize(static_cast<std::size_t>(r.outcome) + 1, 0);
+      ++faces[static_cast<std::size_t>(r.outcome)];
       break;
     case TossStatus::Unresolved: ++unresolved; break;
     case TossStatus::Invalid: ++invalid; break;
@@ -21,7 +22,12 @@ void RunCounts::add(const TossResult& r) {
 }
 
 void RunCounts::merge(const RunCounts& o) {
-  for (std::size_t i = 0; i < faces.size(); ++i) faces[i] += o.faces[i];
+  // An empty count (no tosses yet) takes the other's number of outcomes.
+  if (total() == 0 && bounces == 0 && o.faces.size() != faces.size() &&
+      std::all_of(faces.begin(), faces.end(), [](std::uint64_t c) { return c == 0; }))
+    faces.assign(o.faces.size(), 0);
+  if (o.faces.size() > faces.size()) faces.resize(o.faces.size(), 0);
+  for (std::size_t i = 0; i < o.faces.size(); ++i) faces[i] += o.faces[i];
   settled += o.settled;
   unresolved += o.unresolved;
   invalid += o.invalid;
@@ -37,14 +43,14 @@ RunCounts run_tosses(const DieModel& m, const RunConfig& cfg) {
   const int threads = static_cast<int>(std::max<std::uint64_t>(1, std::min<std::uint64_t>(cfg.threads, n_chunks)));
 
   std::atomic<std::uint64_t> next{0}, done{0};
-  std::vector<RunCounts> partial(static_cast<std::size_t>(threads));
+  std::vector<RunCounts> partial(static_cast<std::size_t>(threads), RunCounts(m.outcomes()));
   auto work = [&](RunCounts& out) {
     for (;;) {
       if (cfg.cancel && cfg.cancel->load(std::memory_order_relaxed)) return;
       const std::uint64_t c = next.fetch_add(1, std::memory_order_relaxed);
       if (c >= n_chunks) return;
       const std::uint64_t lo = c * chunk, hi = std::min(cfg.tosses, lo + chunk);
-      RunCounts local;
+      RunCounts local(m.outcomes());
       for (std::uint64_t i = lo; i < hi; ++i) local.add(toss(m, cfg.seed, cfg.first + i));
       out.merge(local);
       done.fetch_add(hi - lo, std::memory_order_relaxed);
@@ -70,7 +76,7 @@ RunCounts run_tosses(const DieModel& m, const RunConfig& cfg) {
       finished = true;
     }
   }
-  RunCounts total;
+  RunCounts total(m.outcomes());
   for (const RunCounts& p : partial) total.merge(p);
   if (cfg.progress) cfg.progress(done.load(), cfg.tosses);
   return total;

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "sim/body/die_model.hpp"
 #include "sim/models/toss.hpp"
@@ -32,7 +33,11 @@ struct RunCorrections {
 };
 
 struct RunCounts {
-  std::array<std::uint64_t, 6> faces{};  // settled tosses by face index (+x, -x, +y, -y, +z, -z)
+  RunCounts() = default;
+  explicit RunCounts(int outcomes) : faces(static_cast<std::size_t>(outcomes), 0) {}
+  // Settled tosses per outcome, in label order (the model's outcome_labels; several faces may
+  // share one). Six zeros by default, the wire's six outcomes; run_tosses sizes it to the model.
+  std::vector<std::uint64_t> faces = std::vector<std::uint64_t>(6, 0);
   std::uint64_t settled = 0, unresolved = 0, invalid = 0;
   std::uint64_t bounces = 0;  // impacts over all tosses
   RunCorrections corrections;  // guards and fallbacks over all tosses

@@ -1,6 +1,8 @@
 #include "sim/models/compile.hpp"
 #include "sim/study/sweep.hpp"
 
+#include "sim/body/outcome.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
@@ -338,6 +340,10 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
     std::vector<std::string> all = spec.overrides;
     all.insert(all.end(), p.overrides.begin(), p.overrides.end());
     models.push_back(compile(load_scene(spec.scene, all), spec.scene));
+    if (models.back().outcomes() != 6)
+      throw SceneError(spec.scene, "die.shape", models.back().kind,
+                       "sweeps need a die with six outcomes for now (this one has " +
+                           std::to_string(models.back().outcomes()) + "); use `dicesim toss` per value");
     overrides.push_back(std::move(all));
   }
   SweepResult out;
@@ -366,7 +372,7 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
       r.counts = run_tosses(models[i], cfg);
     }
     if (opt.cancel && opt.cancel->load()) break;  // a cancelled point is incomplete: not reported
-    r.labels = models[i].face_labels;
+    r.labels = six_outcome_labels(models[i]);
     r.fidelity = to_string(models[i].fidelity);
     out.points.push_back(std::move(r));
     if (opt.progress) opt.progress(before + spec.tosses, total);

@@ -34,12 +34,34 @@ void put3(double (&out)[3], const Vec3& v) {
 
 }  // namespace
 
-WorkerCore::WorkerCore(WorkerConfig cfg, Send send) : cfg_(std::move(cfg)), send_(std::move(send)), host_(hostname()) {
+WorkerCore::WorkerCore(WorkerConfig cfg, Send send)
+    : cfg_(std::move(cfg)), send_(std::move(send)), sealer_(cfg_.key), host_(hostname()) {
   if (cfg_.worker_id == 0) cfg_.worker_id = random_id();
   cfg_.batch = std::clamp(cfg_.batch, 1, wire::kMaxBatch);
 }
 
+void WorkerCore::send(const char* channel, std::vector<std::uint8_t> bytes) {
+  sealer_.seal(channel, bytes);
+  send_(channel, bytes);
+}
+
 void WorkerCore::on_message(std::string_view channel, const void* data, std::size_t len, double now) {
+  if (channel != wire::kRunStart && channel != wire::kWorkLease && channel != wire::kProbabilities) return;
+  if (const auto payload = sealer_.open(channel, data, len)) {
+    len = *payload;
+  } else {
+    ++unauthenticated_;
+    if (!told_key_ && channel == wire::kRunStart && cfg_.log) {
+      told_key_ = true;
+      cfg_.log("ignoring a run_start that fails the HMAC check (no seal, or another key): unauthenticated messages "
+               "are dropped and counted");
+    }
+    return;
+  }
+  if (!sealer_.enabled() && channel == wire::kRunStart && wire::looks_sealed(data, len) && !told_key_ && cfg_.log) {
+    told_key_ = true;
+    cfg_.log("heard a run whose messages carry an HMAC seal: this worker has no key (dicesim worker --key-file FILE)");
+  }
   if (channel == wire::kRunStart) {
     if (auto m = wire::decode<dicesim_lcm::run_start>(data, len)) return on_run_start(*m, now);
   } else if (channel == wire::kWorkLease) {
@@ -49,8 +71,6 @@ void WorkerCore::on_message(std::string_view channel, const void* data, std::siz
       if (run_ && m->run_id == run_->spec.run_id && m->finished == 1) end_run("finished");
       return;
     }
-  } else {
-    return;  // not a channel a worker listens to
   }
   ++ignored_;
 }
@@ -105,12 +125,12 @@ void WorkerCore::on_lease(const dicesim_lcm::work_lease& m) {
   last_lease_seen_ = std::max(last_lease_seen_, m.lease_id);
 }
 
-void WorkerCore::end_run(const char* why) {
+void WorkerCore::end_run(const char* why, bool final) {
   if (!run_) return;
   if (cfg_.log)
     cfg_.log("run " + std::to_string(run_->spec.run_id) + " ended: " + why + " (" + std::to_string(tosses_done_) +
              " tosses by this worker)");
-  ended_runs_.insert(run_->spec.run_id);
+  if (final) ended_runs_.insert(run_->spec.run_id);
   run_.reset();
   if (cfg_.on_run) cfg_.on_run(0);
   leases_.clear();
@@ -133,11 +153,11 @@ void WorkerCore::send_status(double now) {
   s.tosses_done = static_cast<std::int64_t>(tosses_done_);
   s.tosses_per_s = rate_;
   s.traces_skipped = static_cast<std::int64_t>(traces_skipped_);
-  send_(wire::kWorkerStatus, wire::encode(s));
+  send(wire::kWorkerStatus, wire::encode(s));
 }
 
 void WorkerCore::tick(double now) {
-  if (run_ && now - run_->last_heard > cfg_.run_silence_s) end_run("no run_start heard for a while");
+  if (run_ && now - run_->last_heard > cfg_.run_silence_s) end_run("no run_start heard for a while", false);
   if (now - rate_t_ >= 1.0) {
     rate_ = static_cast<double>(tosses_done_ - rate_n_) / (now - rate_t_);
     rate_t_ = now;
@@ -210,10 +230,10 @@ bool WorkerCore::step(double now) {
       put3(s.angular_velocity_after, rec.after.omega);
       s.contact_vertex = rec.vertex;
       s.impulse = rec.impulse;
-      send_(wire::kBounceState, wire::encode(s));
+      send(wire::kBounceState, wire::encode(s));
     }
   }
-  send_(wire::kTossBatch, wire::encode(b));
+  send(wire::kTossBatch, wire::encode(b));
   l.next += n;
   tosses_done_ += n;
   if (l.next == l.end) {
@@ -258,6 +278,9 @@ int run_worker(const WorkerOptions& opt) {
     if (opt.once && core.runs_finished() > 0) break;
     if (!core.step(now)) bus.handleTimeout(50);
   }
+  if (opt.core.log && core.unauthenticated() > 0)
+    opt.core.log("dropped " + std::to_string(core.unauthenticated()) +
+                 " messages that failed the HMAC check (unsealed, forged, tampered or another key)");
   return 0;
 }
 

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "messages/auth.hpp"
 #include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
 #include "sim/body/die_model.hpp"
@@ -30,6 +31,9 @@ struct WorkerConfig {
   double max_trace_per_s = 2000.0;   // bounce_state messages per second at most (publishers pace themselves)
   std::function<void(const std::string&)> log;  // human-readable events (stderr)
   std::function<void(std::int64_t run_id)> on_run;  // the run served changed (0: none); e.g. log context
+  // The run key (messages/auth.hpp): every message out is sealed, every message in must open
+  // (else it is dropped and counted: unauthenticated()). Empty: no authentication.
+  std::vector<std::uint8_t> key;
 };
 
 class WorkerCore {
@@ -48,6 +52,7 @@ class WorkerCore {
   int runs_finished() const { return runs_finished_; }
   std::uint64_t tosses_done() const { return tosses_done_; }
   std::uint64_t ignored() const { return ignored_; }  // undecodable or inapplicable messages
+  std::uint64_t unauthenticated() const { return unauthenticated_; }  // with a key: failed the HMAC check
 
  private:
   struct Run {
@@ -63,7 +68,10 @@ class WorkerCore {
 
   void on_run_start(const dicesim_lcm::run_start& m, double now);
   void on_lease(const dicesim_lcm::work_lease& m);
-  void end_run(const char* why);
+  // `final`: the run is over for good (finished, replaced); otherwise (its aggregator went
+  // silent) the same run may be served again when its run_start comes back (a resumed aggregator).
+  void end_run(const char* why, bool final = true);
+  void send(const char* channel, std::vector<std::uint8_t> bytes);
   void send_status(double now);
   void trace(std::uint64_t index, double now);
 
@@ -73,7 +81,9 @@ class WorkerCore {
   std::set<std::int64_t> ended_runs_;
   std::deque<Lease> leases_;
   std::int64_t last_lease_seen_ = 0, last_done_ = 0;
-  std::uint64_t tosses_done_ = 0, ignored_ = 0, traces_skipped_ = 0;
+  std::uint64_t tosses_done_ = 0, ignored_ = 0, traces_skipped_ = 0, unauthenticated_ = 0;
+  wire::Sealer sealer_;
+  bool told_key_ = false;  // logged once that sealed / unsealed runs were heard
   int runs_finished_ = 0;
   double last_status_ = -1e9;
   double rate_ = 0.0, rate_t_ = 0.0;

@@ -2,7 +2,7 @@
 # The LCM -> DDS bridge with real processes, each scenario inside a private network namespace
 # this script creates (only loopback: nothing can leave it). Run by CTest, one scenario per test:
 #   dds_scenarios.sh DICESIM_BINARY DDS_SUBSCRIBER_BINARY LCM_INJECT_BINARY SCENARIO
-# Scenarios: late_subscriber final_values restart replay (tests/integration/README.md).
+# Scenarios: late_subscriber final_values restart replay authenticated (tests/integration/README.md).
 # The bridge finds its loopback configuration by itself (bridge/cyclonedds-loopback.xml next to
 # the build); the example subscriber is pointed at the same file with CYCLONEDDS_URI.
 set -euo pipefail
@@ -20,7 +20,12 @@ fail() {
 }
 
 # The subscriber, as any external program would run it (only the config file from the repo).
-subscriber() { CYCLONEDDS_URI="file://$src_dir/bridge/cyclonedds-loopback.xml" "$sub" --json "$@"; }
+# Started with `&`, it runs in a subshell: exec there, so that the pid in $! (killed at exit) is
+# the subscriber itself and none is left running after the script.
+subscriber() {
+  if [ "$BASHPID" != "$$" ]; then CYCLONEDDS_URI="file://$src_dir/bridge/cyclonedds-loopback.xml" exec "$sub" --json "$@"; fi
+  CYCLONEDDS_URI="file://$src_dir/bridge/cyclonedds-loopback.xml" "$sub" --json "$@"
+}
 bridge() { "$bin" bridge "$@" 2> "$work/bridge.err" & bridge_pid=$!; pids+=($bridge_pid); }
 nworkers=0
 worker() { nworkers=$((nworkers + 1)); "$bin" worker "$@" 2> "$work/worker$nworkers.err" & pids+=($!); }
@@ -156,6 +161,30 @@ case "$scenario" in
     run=$(tail -n1 "$work/replayed.jsonl" | run_id)
     same_as_json "$work/replayed.jsonl" "$run" "$work/run.json"
     stops_cleanly TERM
+    ;;
+  authenticated)
+    # `bridge --key-file` on an authenticated run, with a forger on the bus (lcm_inject forge): its
+    # unsealed and wrong-key "finished" answers must never reach DDS. The subscriber stops at the
+    # first finished answer it gets: it must be the real one.
+    key=$work/run.key
+    (umask 077; od -An -tx1 -N32 /dev/urandom | tr -d ' \n' > "$key")
+    bridge --key-file "$key"
+    subscriber --topic probabilities --until-finished --timeout 120 > "$work/sub.jsonl" 2> "$work/sub.err" & subp=$!; pids+=($subp)
+    sleep 1  # DDS discovery between bridge and subscriber
+    "$inject" forge > "$work/forge.out" 2> "$work/forge.err" & forger=$!; pids+=($forger)
+    "$bin" aggregate "$scene" --tosses 300000 --seed $seed --json --timeout 150 --key-file "$key" > "$work/agg.json" 2> "$work/agg.err" & agg=$!
+    pids+=($agg)
+    for _ in $(seq 300); do grep -q "forged batches" "$work/forge.out" && break; sleep 0.1; done
+    worker --once --key-file "$key"; worker --once --key-file "$key"
+    wait "$agg" || fail "aggregate exited $?"
+    wait "$forger" || fail "the forger failed"
+    wait "$subp" || fail "subscriber exited $?"
+    run=$(run_id < "$work/sub.jsonl")
+    same_as_json "$work/sub.jsonl" "$run" "$work/agg.json"
+    stops_cleanly TERM
+    got=$(grep -oE '[0-9]+ unauthenticated' "$work/bridge.err" | grep -oE '[0-9]+')
+    echo "bridge: $got unauthenticated LCM messages dropped; $(cat "$work/forge.out" | tr '\n' ' ')"
+    [ "${got:-0}" -gt 0 ] || fail "the bridge counted no forgeries"
     ;;
   *) echo "unknown scenario $scenario" >&2; exit 2 ;;
 esac

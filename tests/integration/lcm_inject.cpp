@@ -4,6 +4,12 @@
 //   lcm_inject progress FRACTION SECONDS
 //                             returns 0 as soon as a running run has done >= FRACTION of its
 //                             tosses (from DICESIM_PROBABILITIES); 1 if it finished or time ran out
+//   lcm_inject forge          a forger who knows the run id (from run_start, seal stripped) but not
+//                             the key: publishes toss_batch messages claiming face 6 for every index
+//                             (from the top, so they come before the workers' results), unsealed,
+//                             sealed with a wrong key, and genuine sealed batches with their faces
+//                             changed; plus `finished` probabilities and a run_start with another
+//                             seed, to stop or mislead the workers. Prints how many of each it sent.
 //   lcm_inject count CHANNEL SECONDS
 //                             prints how many valid messages of CHANNEL's type arrived
 //                             (after SECONDS, or at SIGTERM)
@@ -19,6 +25,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "messages/auth.hpp"
 #include "messages/wire.hpp"
 
 namespace w = dicesim::wire;
@@ -36,12 +43,22 @@ struct Listener {
   double fraction = -1.0;  // progress mode
   int progress = -1;       // -1 waiting, 0 reached while running, 1 finished first
   std::int64_t done = 0;
+  std::vector<std::uint8_t> captured;  // a genuine (sealed) toss_batch, for the forger to tamper with
   void handle(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+    // A seal is not a secret: anyone can strip it and read the message (only forging needs the key).
+    const std::size_t len = w::looks_sealed(rb->data, rb->data_size) ? rb->data_size - w::kSealSize : rb->data_size;
     if (ch == w::kRunStart) {
-      if (auto m = w::decode<dicesim_lcm::run_start>(rb->data, rb->data_size)) run = *m, have_run = true;
+      if (auto m = w::decode<dicesim_lcm::run_start>(rb->data, len)) run = *m, have_run = true;
+    }
+    if (ch == w::kTossBatch && captured.empty() && len != rb->data_size) {
+      // A worker's, not one of our own forgeries (worker id 42) coming back.
+      if (auto b = w::decode<dicesim_lcm::toss_batch>(rb->data, len); b && b->worker_id != 42) {
+        const auto* p = static_cast<const std::uint8_t*>(rb->data);
+        captured.assign(p, p + rb->data_size);
+      }
     }
     if (fraction >= 0 && ch == w::kProbabilities && progress < 0) {
-      if (auto m = w::decode<dicesim_lcm::probabilities>(rb->data, rb->data_size)) {
+      if (auto m = w::decode<dicesim_lcm::probabilities>(rb->data, len)) {
         done = m->done;
         if (m->finished) progress = 1;
         else if (m->total > 0 && static_cast<double>(m->done) >= fraction * static_cast<double>(m->total)) progress = 0;
@@ -49,10 +66,10 @@ struct Listener {
     }
     if (ch != want) return;
     bool ok = false;
-    if (ch == w::kBounceState) ok = w::decode<dicesim_lcm::bounce_state>(rb->data, rb->data_size).has_value();
-    else if (ch == w::kProbabilities) ok = w::decode<dicesim_lcm::probabilities>(rb->data, rb->data_size).has_value();
-    else if (ch == w::kTossBatch) ok = w::decode<dicesim_lcm::toss_batch>(rb->data, rb->data_size).has_value();
-    else if (ch == w::kWorkerStatus) ok = w::decode<dicesim_lcm::worker_status>(rb->data, rb->data_size).has_value();
+    if (ch == w::kBounceState) ok = w::decode<dicesim_lcm::bounce_state>(rb->data, len).has_value();
+    else if (ch == w::kProbabilities) ok = w::decode<dicesim_lcm::probabilities>(rb->data, len).has_value();
+    else if (ch == w::kTossBatch) ok = w::decode<dicesim_lcm::toss_batch>(rb->data, len).has_value();
+    else if (ch == w::kWorkerStatus) ok = w::decode<dicesim_lcm::worker_status>(rb->data, len).has_value();
     count += ok ? 1 : 0;
   }
 };
@@ -136,6 +153,64 @@ int hostile(lcm::LCM& bus, Listener& in) {
   return 0;
 }
 
+int forge(lcm::LCM& bus, Listener& in) {
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!in.have_run) {
+    bus.handleTimeout(20);
+    if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(30)) return 1;
+  }
+  const std::int64_t run = in.run.run_id, total = in.run.total_tosses;
+  std::vector<std::uint8_t> wrong_key(32);
+  std::mt19937 rng(777);
+  for (auto& b : wrong_key) b = static_cast<std::uint8_t>(rng());
+  w::Sealer wrong(wrong_key);
+  int unsealed = 0, wrong_sealed = 0, tampered = 0, to_workers = 0;
+  // Every index claimed as face 6 (a settled toss), top down: the workers start at index 0.
+  for (std::int64_t first = total; first > 0;) {
+    const int n = static_cast<int>(std::min<std::int64_t>(w::kMaxBatch, first));
+    first -= n;
+    auto bytes = w::encode(batch(run, first, n, 6, 0));
+    send_raw(bus, w::kTossBatch, bytes, &unsealed);
+    wrong.seal(w::kTossBatch, bytes);
+    send_raw(bus, w::kTossBatch, bytes, &wrong_sealed);
+    if (in.captured.empty()) bus.handleTimeout(0);
+  }
+  // The scenario starts the workers only now: every index is claimed by a forgery first.
+  std::printf("forged batches: unsealed %d, wrong key %d\n", unsealed, wrong_sealed);
+  std::fflush(stdout);
+  // A genuine batch, faces changed, seal kept: the MAC covers every byte.
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (in.captured.empty() && std::chrono::steady_clock::now() < until) bus.handleTimeout(20);
+  if (in.captured.empty()) {
+    std::fprintf(stderr, "forge: no sealed toss_batch heard\n");
+    return 1;
+  }
+  // The workers are at work: messages that would stop or mislead the workers: "finished", and the run with another seed.
+  dicesim_lcm::probabilities fin{};
+  fin.run_id = run;
+  fin.finished = 1;
+  fin.total = total;
+  dicesim_lcm::run_start other = in.run;
+  other.seed += 1;
+  for (int k = 0; k < 5; ++k) {
+    send(bus, w::kProbabilities, fin, &to_workers);
+    auto bytes = w::encode(fin);
+    wrong.seal(w::kProbabilities, bytes);
+    send_raw(bus, w::kProbabilities, bytes, &to_workers);
+    send(bus, w::kRunStart, other, &to_workers);
+  }
+  for (int k = 0; k < 20; ++k) {
+    std::vector<std::uint8_t> t = in.captured;
+    // Payload: hash 8, utime run worker lease first 5x8, count 4, then faces (count bytes).
+    const std::size_t face0 = 8 + 5 * 8 + 4;
+    t[face0 + static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(t[face0 + static_cast<std::size_t>(k)] % 6 + 1);
+    if (k % 2) t[t.size() - 1] ^= 1;  // and a flipped bit of the tag itself
+    send_raw(bus, w::kTossBatch, t, &tampered);
+  }
+  std::printf("forged later: tampered %d, aimed at workers %d\n", tampered, to_workers);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -145,6 +220,7 @@ int main(int argc, char** argv) {
   bus.subscribe(".*", &Listener::handle, &in)->setQueueCapacity(100000);
   const std::string mode = argc > 1 ? argv[1] : "";
   if (mode == "hostile") return hostile(bus, in);
+  if (mode == "forge") return forge(bus, in);
   if (mode == "progress" && argc == 4) {
     in.fraction = std::stod(argv[2]);
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(std::stod(argv[3]));
@@ -160,6 +236,6 @@ int main(int argc, char** argv) {
     std::printf("%d\n", in.count);
     return 0;
   }
-  std::fprintf(stderr, "usage: lcm_inject hostile | progress FRACTION SECONDS | count CHANNEL SECONDS\n");
+  std::fprintf(stderr, "usage: lcm_inject hostile | forge | progress FRACTION SECONDS | count CHANNEL SECONDS\n");
   return 2;
 }

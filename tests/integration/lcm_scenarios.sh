@@ -4,6 +4,7 @@
 # leave the namespace. Run by CTest (tests/CMakeLists.txt), one scenario per test:
 #   lcm_scenarios.sh DICESIM_BINARY LCM_INJECT_BINARY SCENARIO
 # Scenarios: three_workers kill9 drop10 replay late_join hostile run_cmd sweep_workers interrupt target trace
+#            forgery agg_restart
 # Every scenario compares the distributed JSON with `dicesim toss --threads 1` after removing
 # only the keys that may differ (elapsed_s, tosses_per_s, threads): identical counts, p, CIs.
 set -euo pipefail
@@ -185,6 +186,95 @@ case "$scenario" in
     traced=$(cat "$work/count.out")
     echo "bounce_state messages received: $traced"
     [ "${traced:-0}" -gt 0 ] || fail "no bounce states published with --trace-every"
+    ;;
+  forgery)
+    # An authenticated run (--key-file everywhere) and a forger who knows the run id but not the
+    # key: batches claiming face 6 for every index (before the workers get there), with no seal,
+    # with a wrong key's seal, and genuine batches with faces changed; "finished" answers and a
+    # run_start with another seed for the workers. Counts identical; every forgery dropped and counted.
+    n=300000
+    reference
+    key=$work/run.key
+    (umask 077; od -An -tx1 -N32 /dev/urandom | tr -d ' \n' > "$key")
+    "$bin" record -o "$work/run.lcmlog" --until-done --timeout 120 --key-file "$key" 2> "$work/rec.err" & rec=$!; pids+=($rec)
+    for _ in $(seq 100); do grep -q "dicesim record: recording" "$work/rec.err" && break; sleep 0.1; done
+    "$inject" forge > "$work/forge.out" 2> "$work/forge.err" & forger=$!; pids+=($forger)
+    aggregate --key-file "$key" & agg=$!
+    # Workers only once every index has been claimed by forged batches: without the HMAC check the
+    # aggregator would have had the whole run from the forger (all face 6) before any real result.
+    for _ in $(seq 300); do grep -q "forged batches" "$work/forge.out" && break; sleep 0.1; done
+    grep -q "forged batches" "$work/forge.out" || fail "the forger never forged"
+    worker --key-file "$key"; worker --key-file "$key"
+    wait "$agg" || fail "aggregate exited $?"
+    same_as_reference "$work/out.json"
+    wait "$forger" || fail "the forger failed: $(cat "$work/forge.err")"
+    cat "$work/forge.out"
+    sent=$(( $(grep "forged batches" "$work/forge.out" | grep -oE '[0-9]+' | paste -sd+) ))  # no bc: not in every image
+    got=$(health unauthenticated "$work/agg.err")
+    echo "forged batches sent before the workers started: $sent; unauthenticated messages dropped by the aggregator: $got"
+    # The aggregator hears every channel, so every forgery (LCM over loopback loses none here).
+    [ "$got" -ge "$sent" ] || fail "the aggregator counted $got unauthenticated messages of $sent forged"
+    for k in 1 2; do
+      wait "${wpid[$k]}" || fail "worker $k exited $?"
+      grep -qE "ended: finished \([1-9][0-9]* tosses" "$work/worker$k.err" || fail "worker $k did no tosses (stopped by a forgery?)"
+      grep -qE "dropped [1-9][0-9]* messages that failed the HMAC check" "$work/worker$k.err" || fail "worker $k counted no forgeries"
+    done
+    wait "$rec" || fail "dicesim record --key-file exited $?"
+    # The log holds the forgeries too (a recorder writes what it hears): replay --key-file drops them.
+    "$bin" replay "$work/run.lcmlog" --key-file "$key" --json > "$work/replay.json" 2> "$work/replay.err" ||
+      fail "replay --key-file exited $?"
+    same_as_reference "$work/replay.json"
+    [ "$(health unauthenticated "$work/replay.err")" -ge "$sent" ] || fail "replay did not drop the recorded forgeries"
+    code=0; "$bin" replay "$work/run.lcmlog" --json > /dev/null 2> "$work/nokey.err" || code=$?
+    [ "$code" -eq 2 ] && grep -q "replay it with --key-file" "$work/nokey.err" || fail "replay without the key: exit $code, $(cat "$work/nokey.err")"
+    (umask 077; od -An -tx1 -N32 /dev/urandom | tr -d ' \n' > "$work/other.key")
+    code=0; "$bin" replay "$work/run.lcmlog" --key-file "$work/other.key" --json > /dev/null 2> "$work/otherkey.err" || code=$?
+    [ "$code" -eq 2 ] || fail "replay with another key: exit $code"
+    ;;
+  agg_restart)
+    # The aggregator itself dies (kill -9) mid-run and is resumed from its checkpoint: the same run
+    # id, the same two workers (never restarted), counts identical to toss; a recorder across the
+    # restart gives a log that replays to the same counts and says how many tosses were computed twice.
+    n=1000000
+    reference
+    ckpt=$work/run.ckpt
+    "$bin" record -o "$work/run.lcmlog" --until-done --timeout 150 2> "$work/rec.err" & rec=$!; pids+=($rec)
+    for _ in $(seq 100); do grep -q "dicesim record: recording" "$work/rec.err" && break; sleep 0.1; done
+    worker; worker
+    t0=$(date +%s%N)
+    "$bin" aggregate "$scene" --tosses "$n" --seed "$seed" --json --timeout 150 --checkpoint "$ckpt" \
+      > "$work/first.json" 2> "$work/agg1.err" & agg1=$!; pids+=($agg1)
+    # The first checkpoint (written at once) holds no toss; kill after one that does.
+    held() { jq '[.received[] | .[1] - .[0]] | add // 0' "$ckpt" 2> /dev/null || echo 0; }
+    for _ in $(seq 300); do [ -s "$ckpt" ] && [ "$(held)" -gt 0 ] && break; sleep 0.02; done
+    [ "$(held)" -gt 0 ] || fail "no checkpoint holding tosses was written"
+    kill -9 "$agg1"; wait "$agg1" 2> /dev/null || true
+    tk=$(date +%s%N)
+    echo "killed the aggregator; its last checkpoint holds $(held) of $n tosses"
+    "$bin" aggregate --resume "$ckpt" --json --timeout 150 > "$work/out.json" 2> "$work/agg.err" || fail "aggregate --resume exited $?"
+    t1=$(date +%s%N)
+    same_as_reference "$work/out.json"
+    [ ! -s "$work/first.json" ] || fail "the killed aggregator printed a result"
+    grep -h "resumed run\|checkpoint '" "$work/agg.err" || fail "no report of what the resume found"
+    grep -q "checkpoint '$ckpt'" "$work/agg.err" || fail "no checkpoint cost line"
+    for k in 1 2; do
+      wait "${wpid[$k]}" || fail "worker $k exited $?"
+      [ "$(grep -c "ended:" "$work/worker$k.err")" = 1 ] && grep -qE "ended: finished \([1-9][0-9]* tosses" "$work/worker$k.err" ||
+        fail "worker $k did not serve the run through the restart"
+    done
+    wait "$rec" || fail "dicesim record exited $?"
+    "$bin" replay "$work/run.lcmlog" --json > "$work/replay.json" 2> "$work/replay.err" || fail "replay exited $?"
+    same_as_reference "$work/replay.json"
+    twice=$(grep -oE '\(([0-9]+) more than once' "$work/replay.err" | grep -oE '[0-9]+')
+    # Bound: the work done after the checkpoint the resume read was taken — its age at the resume
+    # (about one checkpoint interval plus the restart gap; more when fsync is slow) — plus one
+    # interval of slack for the rate's ups and downs, plus the leases the workers had queued
+    # (2 each, at most 8192 tosses), at the run's average throughput.
+    rate=$((n * 1000000000 / (t1 - t0)))
+    age_ms=$(grep -oE 'checkpoint [0-9.]+ s old' "$work/agg.err" | grep -oE '[0-9.]+' | awk '{ printf "%d", $1 * 1000 }')
+    bound=$((rate * (age_ms + 1000) / 1000 + 2 * 2 * 8192))
+    echo "aggregator killed and resumed: $twice tosses computed twice (bound $bound: checkpoint $age_ms ms old at the resume + 1 s, at $rate tosses/s, + queued leases)"
+    [ -n "$twice" ] && [ "$twice" -le "$bound" ] || fail "tosses computed twice: '$twice', more than $bound"
     ;;
   *) echo "unknown scenario $scenario" >&2; exit 2 ;;
 esac

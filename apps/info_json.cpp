@@ -1,0 +1,74 @@
+// The compiled die as JSON (`dicesim info --json` and the Python module): shape, counts, per face
+// label, normal, area, stable and p_static, mass properties, corners, fidelity, resting geometry.
+#include "apps/info_json.hpp"
+
+#include <cmath>
+#include <vector>
+
+#include "sim/models/fidelity_models.hpp"
+
+namespace dicesim {
+namespace {
+
+nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+nlohmann::json mat(const Mat3& m) { return {vec(m.row(0)), vec(m.row(1)), vec(m.row(2))}; }
+
+// Resting geometry: per face, the COM height on it and the lowest pass out of its basin.
+nlohmann::json rest_json(const DieModel& m) {
+  nlohmann::json faces = nlohmann::json::array();
+  for (std::size_t f = 0; f < m.face_normals.size(); ++f)
+    faces.push_back({{"label", m.face_labels[f]},
+                     {"height", m.face_height[f]},
+                     {"escape_height", std::isfinite(m.face_escape[f]) ? nlohmann::json(m.face_escape[f]) : nlohmann::json()},
+                     {"tip_ratio", m.face_tip_ratio[f]}});
+  return faces;
+}
+
+Vec3 geometric_normal(const DieModel& m, std::size_t f) { return m.geo_to_body.transpose() * m.face_normals[f]; }
+
+}  // namespace
+
+nlohmann::json info_json(const std::string& path, const DieModel& m) {
+  const MassProperties& mp = m.mass_geometric;
+  const std::vector<double> p_static = static_face_probabilities(m, kInfoStaticDirections);
+  nlohmann::json faces = nlohmann::json::array();
+  for (std::size_t f = 0; f < m.face_normals.size(); ++f) {
+    const Vec3 n = geometric_normal(m, f);
+    nlohmann::json face = {{"label", m.face_labels[f]},
+                           {"normal", vec(n)},
+                           {"area", m.face_area[f]},
+                           {"stable", m.face_hold[f] >= 0.0},
+                           {"p_static", p_static[f]}};
+    if (m.kind == "box") face["direction"] = kFaceDirNames[f];
+    faces.push_back(face);
+  }
+  nlohmann::json corners = nlohmann::json::array();
+  for (std::size_t c = 0; c < m.vertices.size(); ++c) {
+    const Vec3 geo = m.geo_to_body.transpose() * m.vertices[c] + mp.com;
+    corners.push_back({{"position", vec(geo)}, {"restitution", m.vertex_restitution[c]}, {"friction", m.vertex_friction[c]}});
+  }
+  return {{"scene", path},
+          {"name", m.name},
+          {"shape", m.kind},
+          {"convex", m.convex},
+          {"rounding", m.rounding},
+          {"read", m.read_down ? "down" : "up"},
+          {"vertex_count", m.vertex_count()},
+          {"face_count", m.face_count()},
+          {"outcomes", m.outcome_labels},
+          {"mass", mp.mass},
+          {"com", vec(mp.com)},
+          {"inertia", mat(mp.inertia)},
+          {"principal_moments", vec(mp.principal_moments)},
+          {"principal_axes", mat(mp.principal_axes)},
+          {"symmetric_top", m.symmetric_top},
+          {"bounding_radius", m.bounding_radius},
+          {"faces", faces},
+          {"corners", corners},
+          {"fidelity", to_string(m.fidelity)},
+          {"fidelity_requested", to_string(m.fidelity_requested)},
+          {"fidelity_reason", m.fidelity_reason},
+          {"rest", rest_json(m)}};
+}
+
+}  // namespace dicesim

@@ -1,0 +1,22 @@
+// What `dicesim info --json` prints: the compiled die as one JSON object. Shared by the CLI and the
+// Python module (python/), so it lives in dicesim_report, which needs nothing of the CLI.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "sim/body/die_model.hpp"
+
+namespace dicesim {
+
+// {"scene", "name", "shape", "convex", "rounding", "read", "vertex_count", "face_count", "outcomes",
+//  "mass", "com", "inertia", "principal_moments", "principal_axes", "symmetric_top", "bounding_radius",
+//  "faces": [{"label", "normal", "area", "stable", "p_static"}], "corners", "fidelity",
+//  "fidelity_requested", "fidelity_reason", "rest"}. p_static: the probability of reading the face in
+//  `static` with a uniform orientation (its Gauss-map basin; a Fibonacci lattice of
+//  kInfoStaticDirections down directions, error ~1e-5).
+inline constexpr int kInfoStaticDirections = 200000;
+nlohmann::json info_json(const std::string& path, const DieModel& m);
+
+}  // namespace dicesim
