@@ -57,19 +57,12 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
 
 void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, double* first_touch) {
   const DieModel& m = *m_;
+  // The impact (solved once per step in step(): it does not depend on d) is already in s0.
   a.s = s0;
   RigidState& s = a.s;
-  // Impact first, at the instant of contact, on the velocity before gravity's kick: restitution
-  // returns the approach speed the corner really had (after the kick it would return g h more,
-  // and gain energy). Then gravity, then the plastic solve that holds the die up.
-  a.impact = false;
+  a.impact = impact_;
+  if (impact_) a.imp = imp_;
   a.next.n = 0;
-  if (c.n > 0) {
-    double un = 0.0;
-    for (int i = 0; i < c.n; ++i) un = std::min(un, corner_velocity(m, s, c.vertex[i]).z());
-    a.impact = un < -(v_impact_ + v_spin_ * s.omega.squaredNorm());
-    if (a.impact) a.imp = apply_friction_impact(m, s, c, /*restitution=*/true);
-  }
   s.velocity.z() -= m.gravity * d;
   if (c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next);
 
@@ -112,8 +105,20 @@ int FixedStepper::step(RigidState& s) {
   const DieModel& m = *m_;
   ContactSet c;
   if (s.position.z() <= m.bounding_radius + touch_tol_) c = touching_corners(m, s, touch_tol_);
-  const RigidState s0 = s;
-  const double E0 = mechanical_energy(m, s0);
+  const double E0 = mechanical_energy(m, s);
+  // Impact first, at the instant of contact, on the velocity before gravity's kick: restitution
+  // returns the approach speed the corner really had (after the kick it would return g h more,
+  // and gain energy). Then (in each trial) gravity, then the plastic solve that holds the die up.
+  // The impact depends only on the step's start, not on its length: solved once, shared by every
+  // trial step.
+  RigidState s0 = s;
+  impact_ = false;
+  if (c.n > 0) {
+    double un = 0.0;
+    for (int i = 0; i < c.n; ++i) un = std::min(un, corner_velocity(m, s0, c.vertex[i]).z());
+    impact_ = un < -(v_impact_ + v_spin_ * s0.omega.squaredNorm());
+    if (impact_) imp_ = apply_friction_impact(m, s0, c, /*restitution=*/true);
+  }
   double first = h_;
   try_step(s0, c, h_, a_, &first);
   const Attempt* done = &a_;

@@ -77,6 +77,8 @@ class FixedStepper {
   Mat3 rot_start_ = Mat3::Identity();  // orientation at the start of the step being tried
   Attempt a_, b_, lo_;                  // trial steps (members: ContactImpulses is large)
   ContactImpulses warm_;  // the last plastic solve's impulses (warm start of the next)
+  bool impact_ = false;   // the current step starts with an impact (solved once for all its trials)
+  ImpactResult imp_;      // that impact's result
 };
 
 enum class StepperExit { Settled, LiftOff, Unresolved };
