@@ -367,3 +367,36 @@ TEST(FrictionImpact, MultiContactResultDoesNotDependOnContactOrder) {
   EXPECT_GT(compared, 300);
   EXPECT_LE(unconverged, 8);
 }
+
+// A face of more corners than one solve takes (a 40-sided prism landing flat on its end): the
+// solve keeps the kMaxContacts lowest and the impact counts a fallback, never silently.
+TEST(FrictionImpact, CornersBeyondTheSolversCapAreCountedAsAFallback) {
+  SceneDef scene = parse_scene(R"(
+[materials.plastic]
+density = 1200.0
+[die]
+material = "plastic"
+shape = "prism"
+sides = 40
+radius = 0.01
+length = 0.02
+)", "test");
+  const DieModel m = compile(scene);
+  int end = -1;
+  for (int f = 0; f < m.face_count(); ++f)
+    if (m.face_vertices(f).size() == 40) end = f;
+  ASSERT_GE(end, 0);
+  RigidState s;
+  s.R = Quat::FromTwoVectors(m.face_normals[static_cast<std::size_t>(end)], -Vec3::UnitZ()).toRotationMatrix();
+  double low = 0.0;
+  for (const Vec3& v : m.vertices) low = std::min(low, (s.R * v).z());
+  s.position = Vec3(0.0, 0.0, -low);
+  s.velocity = Vec3(0.0, 0.0, -0.5);
+  s.omega = Vec3::Zero();
+  const ContactSet c = touching_corners(m, s, 1e-9 * m.bounding_radius);
+  EXPECT_EQ(c.n, kMaxContacts);
+  EXPECT_EQ(c.dropped, 40 - kMaxContacts);
+  const ImpactResult imp = apply_friction_impact(m, s, c, /*restitution=*/true);
+  EXPECT_EQ(imp.corrections.fallbacks, 1u);
+  EXPECT_LE(imp.energy_after, imp.energy_before * (1.0 + 1e-12));
+}

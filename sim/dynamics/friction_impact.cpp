@@ -348,7 +348,8 @@ ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol) 
       c.vertex[c.n++] = i;
       continue;
     }
-    int hi = 0;  // full: replace the highest if this one is lower
+    ++c.dropped;  // full: one corner is left out (replace the highest if this one is lower)
+    int hi = 0;
     for (int k = 1; k < c.n; ++k)
       if (z[k] > z[hi]) hi = k;
     if (zi < z[hi]) {
@@ -367,6 +368,7 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
   ImpactResult res;
   if (out) out->n = 0;
   if (c.n == 0) return res;
+  if (c.dropped > 0) ++res.corrections.fallbacks;  // never silent: corners beyond kMaxContacts got no impulse
   const RigidState s0 = s;
   const Mat3 Iw = world_inertia(m, s.R);
   Body b{m.mass, 1.0 / m.mass, s.R * m.principal_moments.cwiseInverse().asDiagonal() * s.R.transpose(), &s};

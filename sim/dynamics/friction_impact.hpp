@@ -42,6 +42,7 @@ inline constexpr int kMaxContacts = 32;
 struct ContactSet {
   int n = 0;
   int vertex[kMaxContacts] = {};
+  int dropped = 0;  // touching corners left out beyond kMaxContacts: the impact counts a fallback
 };
 
 // Impulses per point of one solve (world: x, y tangential, z normal), in the ContactSet's order.
