@@ -7,13 +7,7 @@
 # 2. Cross-check with the real aggregator: a `dicesim run` (4 answers/s) watched by the example
 #    subscriber; latency = receipt wall clock - the answer's utime (same host, same clock).
 set -euo pipefail
-if [ "${DICESIM_NETNS:-}" != "1" ]; then
-  if [ "$(id -u)" -ne 0 ]; then echo "bridge_latency.sh: network namespaces need root" >&2; exit 77; fi
-  exec unshare --net env DICESIM_NETNS=1 "$0" "$@"
-fi
-ip link set lo up
-ip link set lo multicast on
-ip route add 224.0.0.0/4 dev lo
+. "$(dirname "$0")/private_net.sh" "$@"
 export LCM_DEFAULT_URL="udpm://239.255.76.67:7667?ttl=0"
 cd "$(dirname "$0")/.."
 build=${1:-build}

@@ -7,13 +7,7 @@
 #   bench/replay-10m.sh [DICESIM_BINARY] [N] [LOG]     defaults: build/apps/dicesim 10000000 (a temp file)
 # With LOG given and already present, the recording is skipped and that log is timed.
 set -euo pipefail
-if [ "${DICESIM_NETNS:-}" != "1" ]; then
-  if [ "$(id -u)" -ne 0 ]; then echo "needs root (unshare --net)" >&2; exit 77; fi
-  exec unshare --net env DICESIM_NETNS=1 "$0" "$@"
-fi
-ip link set lo up
-ip link set lo multicast on
-ip route add 224.0.0.0/4 dev lo
+. "$(dirname "$0")/private_net.sh" "$@"
 
 cd "$(dirname "$0")/.."
 bin=$(realpath "${1:-build/apps/dicesim}")

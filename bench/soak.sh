@@ -10,13 +10,7 @@
 #   bench/soak.sh [DICESIM] [N] [W] [K] [A]     defaults: build/apps/dicesim 100000000 8 10 (N-dependent)
 # Memory samples stay in $SOAK_OUT (default /tmp/dicesim-soak.csv): t_s,role,pid,rss_kb.
 set -euo pipefail
-if [ "${DICESIM_NETNS:-}" != "1" ]; then
-  if [ "$(id -u)" -ne 0 ]; then echo "soak.sh: needs root (unshare --net, nftables)" >&2; exit 77; fi
-  exec unshare --net env DICESIM_NETNS=1 "$0" "$@"
-fi
-ip link set lo up
-ip link set lo multicast on
-ip route add 224.0.0.0/4 dev lo
+. "$(dirname "$0")/private_net.sh" "$@"
 
 cd "$(dirname "$0")/.."
 bin=$(realpath "${1:-build/apps/dicesim}")
