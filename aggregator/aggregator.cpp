@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <unordered_set>
 
 #include "aggregator/target.hpp"
@@ -10,10 +11,16 @@
 namespace dicesim::agg {
 
 Aggregator::Aggregator(AggregatorConfig cfg, Send send)
-    : cfg_(std::move(cfg)), send_(std::move(send)), limit_(cfg_.spec.total), sealer_(cfg_.key) {
-  for (std::size_t i = 0; i < 6; ++i)
-    if (cfg_.labels[i] >= 1 && cfg_.labels[i] <= 6) label_to_index_[static_cast<std::size_t>(cfg_.labels[i])] =
-        static_cast<std::int8_t>(i + 1);
+    : cfg_(std::move(cfg)),
+      send_(std::move(send)),
+      limit_(cfg_.spec.total),
+      outcomes_(cfg_.spec.labels.size()),
+      prefix_(static_cast<int>(outcomes_)),
+      all_(static_cast<int>(outcomes_)),
+      sealer_(cfg_.key) {
+  if (!wire::valid_outcome_labels(std::vector<std::int32_t>(cfg_.spec.labels.begin(), cfg_.spec.labels.end())))
+    throw std::invalid_argument("the run's outcome labels are not 1 to " + std::to_string(wire::kMaxOutcomes) +
+                                " ascending labels in [0, " + std::to_string(wire::kMaxLabel) + "]");
 }
 
 namespace {
@@ -72,7 +79,7 @@ Aggregator::Aggregator(AggregatorConfig cfg, Send send, const Checkpoint& from, 
 Checkpoint Aggregator::checkpoint(double elapsed_s) const {
   Checkpoint c;
   c.start = wire::to_message(cfg_.spec);
-  c.labels = cfg_.labels;
+  c.labels = cfg_.spec.labels;
   c.target_halfwidth = cfg_.target_halfwidth;
   c.limit = limit_;
   for (const auto& [lo, hi] : received_.ranges_list()) c.received.emplace_back(lo, hi);
@@ -140,7 +147,7 @@ void Aggregator::on_message(std::string_view channel, const void* data, std::siz
 
 bool Aggregator::valid_batch(const dicesim_lcm::toss_batch& b) const {
   const std::size_t n = static_cast<std::size_t>(b.count);
-  if (b.count < 1 || b.faces.size() != n || b.statuses.size() != n || b.bounces.size() != n) return false;
+  if (b.count < 1 || b.outcomes.size() != n || b.statuses.size() != n || b.bounces.size() != n) return false;
   const std::size_t nc = static_cast<std::size_t>(b.n_corrected);
   if (b.n_corrected < 0 || b.corrected_offset.size() != nc || b.energy_clamps.size() != nc ||
       b.pgs_unconverged.size() != nc || b.overlap_fixes.size() != nc || b.fallbacks.size() != nc)
@@ -150,11 +157,11 @@ bool Aggregator::valid_batch(const dicesim_lcm::toss_batch& b) const {
         b.overlap_fixes[j] < 0 || b.fallbacks[j] < 0)
       return false;
   for (std::size_t k = 0; k < n; ++k) {
-    const int face = b.faces[k], status = b.statuses[k];
+    const int outcome = b.outcomes[k], status = b.statuses[k];
     if (b.bounces[k] < 0) return false;
     if (status == 0) {
-      if (face < 1 || face > 6 || label_to_index_[static_cast<std::size_t>(face)] == 0) return false;
-    } else if ((status != 1 && status != 2) || face != 0) {
+      if (outcome < 0 || static_cast<std::size_t>(outcome) >= outcomes_) return false;
+    } else if ((status != 1 && status != 2) || outcome != -1) {
       return false;
     }
   }
@@ -199,13 +206,13 @@ void Aggregator::ingest(std::uint64_t first, std::uint64_t lo, std::uint64_t hi,
   while (lo < hi) {
     const std::uint64_t block = lo / kTargetBlock;
     const std::uint64_t end = std::min(hi, (block + 1) * kTargetBlock);
-    RunCounts c;
+    RunCounts c(static_cast<int>(outcomes_));
     for (std::uint64_t i = lo; i < end; ++i) {
       const std::size_t k = static_cast<std::size_t>(i - first);
       switch (b.statuses[k]) {
         case 0:
           ++c.settled;
-          ++c.faces[static_cast<std::size_t>(label_to_index_[static_cast<std::size_t>(b.faces[k])] - 1)];
+          ++c.faces[static_cast<std::size_t>(b.outcomes[k])];
           break;
         case 1: ++c.unresolved; break;
         default: ++c.invalid; break;
@@ -221,7 +228,7 @@ void Aggregator::ingest(std::uint64_t first, std::uint64_t lo, std::uint64_t hi,
       c.corrections.overlap_fixes += static_cast<std::uint64_t>(b.overlap_fixes[j]);
       c.corrections.fallbacks += static_cast<std::uint64_t>(b.fallbacks[j]);
     }
-    blocks_[block].merge(c);
+    blocks_.try_emplace(block, static_cast<int>(outcomes_)).first->second.merge(c);
     all_.merge(c);
     lo = end;
   }
@@ -403,17 +410,16 @@ dicesim_lcm::probabilities Aggregator::snapshot() const {
   dicesim_lcm::probabilities m;
   m.utime = wire::now_utime();
   m.run_id = cfg_.spec.run_id;
-  // Faces in label order, as the printed table.
-  std::array<std::size_t, 6> order{0, 1, 2, 3, 4, 5};
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cfg_.labels[a] < cfg_.labels[b]; });
-  for (std::size_t r = 0; r < 6; ++r) {
-    const std::size_t i = order[r];
-    m.face_labels[r] = cfg_.labels[i];
-    m.counts[r] = static_cast<std::int64_t>(c.faces[i]);
-    m.p[r] = c.settled ? static_cast<double>(c.faces[i]) / static_cast<double>(c.settled) : 0.0;
-    const Interval ci = wilson_interval(c.faces[i], c.settled);
-    m.ci_lo[r] = ci.lo;
-    m.ci_hi[r] = ci.hi;
+  // Outcomes in label order (the spec's labels are ascending), as the printed table.
+  m.n_outcomes = static_cast<std::int32_t>(outcomes_);
+  for (std::size_t i = 0; i < outcomes_; ++i) {
+    const std::uint64_t n = i < c.faces.size() ? c.faces[i] : 0;
+    m.labels.push_back(cfg_.spec.labels[i]);
+    m.counts.push_back(static_cast<std::int64_t>(n));
+    m.p.push_back(c.settled ? static_cast<double>(n) / static_cast<double>(c.settled) : 0.0);
+    const Interval ci = wilson_interval(n, c.settled);
+    m.ci_lo.push_back(ci.lo);
+    m.ci_hi.push_back(ci.hi);
   }
   m.settled = static_cast<std::int64_t>(c.settled);
   m.unresolved = static_cast<std::int64_t>(c.unresolved);

@@ -26,8 +26,9 @@
 namespace dicesim::agg {
 
 struct AggregatorConfig {
-  wire::RunSpec spec;               // run_id, seed, total, ...: what run_start announces
-  std::array<int, 6> labels{};      // face label per face index (the model's)
+  // run_id, seed, total, outcome labels, ...: what run_start announces. spec.labels must be a
+  // valid outcome list (wire::valid_outcome_labels), else the constructor throws invalid_argument.
+  wire::RunSpec spec;
   double target_halfwidth = 0.0;    // > 0: stop at the first block boundary where it holds
   std::uint64_t max_lease = 8192;   // tosses per lease at most (a few hundred ms of one core)
   std::uint64_t min_lease = 512;    // ... and at least, except for the last ones
@@ -47,7 +48,7 @@ struct Health {
   std::uint64_t batches = 0;     // accepted toss_batch messages
   std::uint64_t duplicates = 0;  // toss results received again
   std::uint64_t foreign = 0;     // messages of another run
-  std::uint64_t malformed = 0;   // undecodable, or fields outside their domain
+  std::uint64_t malformed = 0;   // undecodable (e.g. claims more than kMaxOutcomes), or fields outside their domain
   std::uint64_t range = 0;       // indices outside [0, total)
   std::uint64_t released = 0;    // tosses leased again
   std::uint64_t leases = 0;      // leases granted
@@ -134,7 +135,7 @@ class Aggregator {
   std::map<std::int64_t, Lease> leases_;
   std::map<std::int64_t, Worker> workers_;
   std::int64_t next_lease_ = 1;
-  std::array<std::int8_t, 7> label_to_index_{};  // label 1..6 -> face index + 1 (0: no such label)
+  std::size_t outcomes_;  // the die's outcome count: a settled result is an index below it
 
   std::map<std::uint64_t, RunCounts> blocks_;  // counts of blocks past the prefix
   RunCounts prefix_;                           // counts of [0, prefix_end_)

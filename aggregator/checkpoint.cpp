@@ -108,6 +108,9 @@ Checkpoint checkpoint_from_json(const std::string& text, const std::string& path
       throw CheckpointError("'" + path + "' is not a dicesim checkpoint (no \"format\": \"" + kFormat + "\")");
     const auto bytes = from_hex(j.at("run_start").get<std::string>());
     auto start = wire::decode<dicesim_lcm::run_start>(bytes.data(), bytes.size());
+    if (!start && wire::legacy_format(bytes.data(), bytes.size()))
+      throw CheckpointError("'" + path + "' was written before runs carried any number of outcomes (its run_start is a " +
+                            wire::legacy_format(bytes.data(), bytes.size()) + "): it cannot be resumed by this dicesim");
     if (!start || start->run_id == 0 || start->total_tosses <= 0)
       throw CheckpointError("'" + path + "': its run_start does not decode (a checkpoint of another dicesim version?)");
     c.start = *start;
@@ -115,7 +118,7 @@ Checkpoint checkpoint_from_json(const std::string& text, const std::string& path
     c.elapsed_s = j.at("elapsed_s").get<double>();
     c.finished = j.at("finished").get<bool>();
     c.resumes = j.at("resumes").get<int>();
-    c.labels = j.at("labels").get<std::array<int, 6>>();
+    c.labels = j.at("labels").get<std::vector<int>>();
     c.target_halfwidth = j.at("target_halfwidth").get<double>();
     c.limit = j.at("limit").get<std::uint64_t>();
     for (const auto& r : j.at("received")) c.received.emplace_back(r.at(0).get<std::uint64_t>(), r.at(1).get<std::uint64_t>());
@@ -149,6 +152,13 @@ Checkpoint checkpoint_from_json(const std::string& text, const std::string& path
   }
   if (c.limit > total || c.frontier > total || c.prefix_end > c.limit || c.all.total() != held || c.next_lease < 1)
     throw CheckpointError("'" + path + "' is inconsistent (limit, frontier, prefix or counts do not match the indices held)");
+  // Every count has one entry per outcome of the run_start's die.
+  bool sizes = std::vector<int>(c.start.outcome_labels.begin(), c.start.outcome_labels.end()) == c.labels &&
+               c.prefix.faces.size() == c.labels.size() && c.all.faces.size() == c.labels.size();
+  for (const auto& [b, counts] : c.blocks) sizes = sizes && counts.faces.size() == c.labels.size();
+  if (!sizes)
+    throw CheckpointError("'" + path + "' is inconsistent (its labels or per-outcome counts do not match its run_start's " +
+                          std::to_string(c.start.outcome_labels.size()) + " outcomes)");
   return c;
 }
 

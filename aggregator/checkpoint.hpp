@@ -42,7 +42,7 @@ struct HealthCounts {  // = Health (aggregator.hpp), kept here so this header st
 
 struct Checkpoint {
   dicesim_lcm::run_start start;        // the run, as announced
-  std::array<int, 6> labels{};
+  std::vector<int> labels;             // the die's outcome labels (= run_start's), counts in this order
   double target_halfwidth = 0.0;
   std::uint64_t limit = 0;             // indices [0, limit) wanted (less than total once a target was met)
   std::vector<IntervalSet::Range> received;

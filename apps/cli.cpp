@@ -9,13 +9,6 @@
 
 namespace dicesim {
 
-void require_six_outcomes(const DieModel& m, const std::string& scene_path) {
-  if (m.outcomes() == 6) return;
-  throw SceneError(scene_path, "die.shape", m.kind,
-                   "distributed runs (run, aggregate, sweep --workers) carry six outcomes on the wire for now; "
-                   "this die has " + std::to_string(m.outcomes()) + ": use `dicesim toss`");
-}
-
 void SceneArgs::add_to(CLI::App* cmd) {
   cmd->add_option("SCENE", path, "Scene file (TOML), e.g. scenes/paper/die1.toml")->required();
   cmd->add_option("--set", overrides,

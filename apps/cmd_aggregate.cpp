@@ -78,7 +78,7 @@ void AggregateArgs::add_checkpoint_options(CLI::App* cmd) {
 DieModel rebuild_checkpoint_model(const agg::Checkpoint& ck, const std::string& path) {
   const wire::RunSpec spec = wire::from_message(ck.start);
   DieModel model = wire::compile_spec(spec);
-  if (wire::model_fingerprint(model) != spec.fingerprint || six_outcome_labels(model) != ck.labels)
+  if (wire::model_fingerprint(model) != spec.fingerprint || model.outcome_labels != ck.labels)
     throw std::runtime_error("checkpoint '" + path + "': this dicesim build compiles the run's scene to a different model "
                              "(fingerprint): resume it with the build that started it");
   return model;
@@ -112,8 +112,6 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   }
   const wire::RunSpec& spec = cfg.spec;
   logging::set_run_id(spec.run_id);
-  require_six_outcomes(model, resume ? a.resume : a.scene.path);
-  cfg.labels = six_outcome_labels(model);
 
   ProgressBar bar;
   std::size_t refusals_shown = 0;

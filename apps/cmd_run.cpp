@@ -25,7 +25,7 @@ struct RunArgs {
 
 int run_run(const RunArgs& a) {
   // Bad input (scene or key file): exit 2 before any child starts.
-  require_six_outcomes(compile(a.agg.scene.load(), a.agg.scene.path), a.agg.scene.path);
+  wire::check_wire_outcomes(compile(a.agg.scene.load(), a.agg.scene.path), a.agg.scene.path);
   (void)load_run_key(a.agg.key_file);
   const std::int64_t run_id = wire::new_run_id();
   // --lcm or $LCM_DEFAULT_URL if given; else the host-confined group on a port of this run's own.

@@ -26,7 +26,7 @@ struct WatchArgs {
   std::string key_file;
 };
 
-// One answer as one line: progress, workers, and each face's p with its 95% half-width.
+// One answer as one line: progress, workers, and each outcome's p with its 95% half-width (label order).
 std::string answer_line(const dicesim_lcm::probabilities& m) {
   char buf[160];
   const double pct = m.total > 0 ? 100.0 * static_cast<double>(m.done) / static_cast<double>(m.total) : 0.0;
@@ -34,8 +34,8 @@ std::string answer_line(const dicesim_lcm::probabilities& m) {
                 m.finished ? "FINISHED" : "running", static_cast<long long>(m.done), static_cast<long long>(m.total),
                 pct, m.workers);
   std::string line = buf;
-  for (int f = 0; f < 6; ++f) {
-    std::snprintf(buf, sizeof buf, "  %d: %.4f±%.4f", m.face_labels[f], m.p[f], 0.5 * (m.ci_hi[f] - m.ci_lo[f]));
+  for (std::size_t f = 0; f < m.labels.size(); ++f) {
+    std::snprintf(buf, sizeof buf, "  %d: %.4f±%.4f", m.labels[f], m.p[f], 0.5 * (m.ci_hi[f] - m.ci_lo[f]));
     line += buf;
   }
   if (m.unresolved || m.invalid) {
@@ -50,11 +50,19 @@ struct Printer {
   const WatchArgs* args;
   wire::Sealer sealer;  // an authenticated run: only answers whose seal opens are shown
   bool finished = false;
+  std::uint64_t malformed = 0;  // undecodable answers (e.g. more than kMaxOutcomes), dropped
+  const char* legacy = nullptr;  // an answer of the six-outcome wire was heard
   void handle(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     const auto len = sealer.open(channel, rb->data, rb->data_size);
     if (!len) return;
     const auto m = wire::decode<dicesim_lcm::probabilities>(rb->data, *len);
-    if (!m || (args->run != 0 && m->run_id != args->run)) return;
+    if (!m) {
+      ++malformed;
+      if (!legacy && (legacy = wire::legacy_format(rb->data, *len)))
+        std::fprintf(stderr, "dicesim: heard a %s: an older dicesim's run, not shown\n", legacy);
+      return;
+    }
+    if (args->run != 0 && m->run_id != args->run) return;
     std::printf("%s\n", answer_line(*m).c_str());
     std::fflush(stdout);
     if (m->finished) finished = true;
@@ -82,6 +90,8 @@ int watch(const WatchArgs& a) {
       return kExitFailed;
     }
   }
+  if (printer.malformed > 0)
+    std::fprintf(stderr, "dicesim: ignored %llu undecodable answers\n", static_cast<unsigned long long>(printer.malformed));
   return kExitOk;
 }
 

@@ -47,10 +47,6 @@ void register_watch(CLI::App& app, int& exit_code);   // cmd_watch.cpp
 void register_record(CLI::App& app, int& exit_code);  // cmd_record.cpp
 void register_replay(CLI::App& app, int& exit_code);  // cmd_replay.cpp
 
-// The LCM wire carries six outcomes until it carries N: `run`, `aggregate` and `sweep --workers`
-// refuse any other die with a SceneError (exit 2) naming the scene and the die's outcome count.
-void require_six_outcomes(const DieModel& m, const std::string& scene_path);
-
 // Distributed runs (cmd_aggregate.cpp): what `aggregate` and `run` share.
 struct AggregateArgs {
   SceneArgs scene;

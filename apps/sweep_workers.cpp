@@ -26,7 +26,6 @@ RunCounts SweepOverLcm::run_point(const DieModel& model, const std::vector<std::
                                   const std::function<void(std::uint64_t)>& progress) {
   agg::AggregatorConfig ac;
   ac.spec = wire::make_run_spec(wire::new_run_id(), scene_, overrides, model, cfg.seed, cfg.tosses);
-  ac.labels = six_outcome_labels(model);
   agg::SessionOptions opt;
   opt.url = url_;
   opt.cancel = cancel_;

@@ -16,7 +16,7 @@ agg::AggregatorConfig bench_config() {
   agg::AggregatorConfig cfg;
   cfg.spec.run_id = 1;
   cfg.spec.total = 1ULL << 40;
-  cfg.labels = {2, 5, 3, 4, 1, 6};
+  cfg.spec.labels = {1, 2, 3, 4, 5, 6};
   return cfg;
 }
 
@@ -25,7 +25,7 @@ std::vector<std::uint8_t> make_batch(std::uint64_t first, int n, std::mt19937& r
   b.run_id = 1, b.worker_id = 2, b.lease_id = 0, b.first_index = static_cast<std::int64_t>(first), b.count = n;
   for (int i = 0; i < n; ++i) {
     const bool settled = rng() % 100 != 0;
-    b.faces.push_back(static_cast<std::int8_t>(settled ? 1 + rng() % 6 : 0));
+    b.outcomes.push_back(static_cast<std::int8_t>(settled ? rng() % 6 : -1));
     b.statuses.push_back(static_cast<std::int8_t>(settled ? 0 : 1));
     b.bounces.push_back(static_cast<std::int32_t>(1 + rng() % 4));
   }

@@ -20,7 +20,7 @@ std::vector<std::uint8_t> batch_bytes(std::uint64_t first, int n) {
   dicesim_lcm::toss_batch b{};
   b.run_id = 1, b.worker_id = 2, b.lease_id = 0, b.first_index = static_cast<std::int64_t>(first), b.count = n;
   for (int i = 0; i < n; ++i) {
-    b.faces.push_back(static_cast<std::int8_t>(1 + rng() % 6));
+    b.outcomes.push_back(static_cast<std::int8_t>(rng() % 6));
     b.statuses.push_back(0);
     b.bounces.push_back(static_cast<std::int32_t>(1 + rng() % 4));
   }
@@ -61,7 +61,7 @@ void BM_AuthenticatedIngest(benchmark::State& state) {
   agg::AggregatorConfig cfg;
   cfg.spec.run_id = 1;
   cfg.spec.total = 1ULL << 40;
-  cfg.labels = {2, 5, 3, 4, 1, 6};
+  cfg.spec.labels = {1, 2, 3, 4, 5, 6};
   if (keyed) cfg.key = kKey;
   agg::Aggregator agg(cfg, [](const char*, const std::vector<std::uint8_t>&) {});
   wire::Sealer s(keyed ? kKey : std::vector<std::uint8_t>{});
@@ -96,7 +96,9 @@ void BM_WorkerBatch(benchmark::State& state) {
   spec.files = wire::read_scene_files(spec.origin);
   spec.seed = 1;
   spec.total = 1ULL << 40;
-  spec.fingerprint = wire::model_fingerprint(wire::compile_spec(spec));
+  const DieModel model = wire::compile_spec(spec);
+  spec.fingerprint = wire::model_fingerprint(model);
+  spec.labels = model.outcome_labels;
   std::uint64_t sent_bytes = 0;
   worker::WorkerConfig cfg;
   cfg.worker_id = 5;

@@ -36,7 +36,7 @@ bool wait_for(dds_entity_t reader, dds_entity_t waitset, std::int64_t run, std::
     const int n = dds_take(reader, samples, infos, 8, 8);
     bool got = false;
     for (int k = 0; k < n; ++k) {
-      const auto* s = static_cast<const dicesim_dds_probabilities*>(samples[k]);
+      const auto* s = static_cast<const dicesim_dds_probabilities_v2*>(samples[k]);
       if (infos[k].valid_data && s->run_id == run && s->done == seq) got = true;
     }
     if (n > 0) dds_return_loan(reader, samples, n);
@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
 
   b::DdsEntity participant(dds_create_participant(DDS_DOMAIN_DEFAULT, nullptr, nullptr), "participant");
   const b::Qos qos = b::latest_per_run_qos();
-  b::DdsEntity topic(dds_create_topic(participant.get(), &dicesim_dds_probabilities_desc, b::kProbabilitiesTopic,
+  b::DdsEntity topic(dds_create_topic(participant.get(), &dicesim_dds_probabilities_v2_desc, b::kProbabilitiesTopic,
                                       qos.get(), nullptr),
                      "topic");
   b::DdsEntity reader(dds_create_reader(participant.get(), topic.get(), qos.get(), nullptr), "reader");
@@ -80,7 +80,12 @@ int main(int argc, char** argv) {
   dicesim_lcm::probabilities m{};
   m.run_id = 0x5eed0000 + (std::chrono::system_clock::now().time_since_epoch().count() & 0xffff);
   m.total = samples;
-  for (int f = 0; f < 6; ++f) m.face_labels[f] = f + 1;
+  m.n_outcomes = 6;
+  for (int f = 0; f < 6; ++f) m.labels.push_back(f + 1);
+  m.counts.assign(6, 0);
+  m.p.assign(6, 0.0);
+  m.ci_lo.assign(6, 0.0);
+  m.ci_hi.assign(6, 0.0);
   auto publish = [&](std::int64_t seq) {
     m.done = seq;
     m.utime = w::now_utime();

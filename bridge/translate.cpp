@@ -1,18 +1,32 @@
 #include "bridge/translate.hpp"
 
+#include <cstdint>
+#include <vector>
+
 namespace dicesim::bridge {
 
-dicesim_dds_probabilities to_dds(const dicesim_lcm::probabilities& m) {
-  dicesim_dds_probabilities s{};
+namespace {
+// A bounded DDS sequence viewing a vector (Cyclone does not free a buffer with _release false).
+template <class Seq, class T>
+Seq view(const std::vector<T>& v) {
+  Seq s{};
+  s._maximum = s._length = static_cast<std::uint32_t>(v.size());
+  s._buffer = const_cast<T*>(v.data());
+  s._release = false;
+  return s;
+}
+}  // namespace
+
+dicesim_dds_probabilities_v2 to_dds(const dicesim_lcm::probabilities& m) {
+  dicesim_dds_probabilities_v2 s{};
   s.run_id = m.run_id;
   s.utime = m.utime;
-  for (int f = 0; f < 6; ++f) {
-    s.face_labels[f] = m.face_labels[f];
-    s.counts[f] = m.counts[f];
-    s.p[f] = m.p[f];
-    s.ci_lo[f] = m.ci_lo[f];
-    s.ci_hi[f] = m.ci_hi[f];
-  }
+  // decode() admits 1..120 outcomes, the sequences' bound.
+  s.labels = view<dds_sequence_long>(m.labels);
+  s.counts = view<dds_sequence_long_long>(m.counts);
+  s.p = view<dds_sequence_double>(m.p);
+  s.ci_lo = view<dds_sequence_double>(m.ci_lo);
+  s.ci_hi = view<dds_sequence_double>(m.ci_hi);
   s.settled = m.settled;
   s.unresolved = m.unresolved;
   s.invalid = m.invalid;
@@ -26,6 +40,7 @@ dicesim_dds_probabilities to_dds(const dicesim_lcm::probabilities& m) {
   s.rejected_malformed = m.rejected_malformed;
   s.rejected_range = m.rejected_range;
   s.released = m.released;
+  s.rejected_unauthenticated = m.rejected_unauthenticated;
   return s;
 }
 

@@ -6,6 +6,7 @@
 
 namespace dicesim::bridge {
 
-dicesim_dds_probabilities to_dds(const dicesim_lcm::probabilities& m);
+// The sample borrows m's per-outcome arrays (no copy, nothing to free): write it while m lives.
+dicesim_dds_probabilities_v2 to_dds(const dicesim_lcm::probabilities& m);
 
 }  // namespace dicesim::bridge

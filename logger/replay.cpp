@@ -1,4 +1,3 @@
-#include "sim/body/outcome.hpp"
 #include "logger/replay.hpp"
 
 #include <algorithm>
@@ -40,6 +39,7 @@ dicesim_lcm::run_start find_run(const std::string& path, std::int64_t want, cons
   wire::Sealer sealer(key);
   std::vector<std::int64_t> seen;
   std::uint64_t sealed = 0, failed = 0;
+  const char* legacy = nullptr;  // a run_start of the six-outcome wire
   std::optional<dicesim_lcm::run_start> found;
   while (const lcm::LogEvent* e = in.next()) {
     if (e->channel != wire::kRunStart) continue;
@@ -55,6 +55,7 @@ dicesim_lcm::run_start find_run(const std::string& path, std::int64_t want, cons
       continue;
     }
     auto m = wire::decode<dicesim_lcm::run_start>(e->data, *len);
+    if (!m && !legacy) legacy = wire::legacy_format(e->data, *len);
     if (!m || m->run_id == 0) continue;
     if (want == 0 || m->run_id == want) {
       found = *m;
@@ -67,6 +68,9 @@ dicesim_lcm::run_start find_run(const std::string& path, std::int64_t want, cons
     throw LogError("'" + path + "' is the log of an authenticated run (its messages carry HMAC seals): replay it with "
                    "--key-file FILE, the run's key");
   if (found) return *found;
+  if (seen.empty() && legacy)
+    throw LogError("'" + path + "' was recorded before runs carried any number of outcomes (its run_start is a " +
+                   legacy + "): this dicesim cannot replay it; replay it with the dicesim that recorded it");
   if (seen.empty() && failed > 0 && sealer.enabled())
     throw LogError("'" + path + "': none of its " + std::to_string(failed) +
                    " run_start messages opens with this key (another run's key, or a log without seals)");
@@ -174,11 +178,11 @@ PassOut feed(const ReplayOptions& opt, const agg::AggregatorConfig& cfg, lcm::LC
   return out;
 }
 
-// The counts of the live aggregator's final message, by face index.
-RunCounts recorded_counts(const dicesim_lcm::probabilities& m, const std::array<int, 6>& labels) {
-  RunCounts c;
-  for (int k = 0; k < 6; ++k) {
-    const auto it = std::find(labels.begin(), labels.end(), m.face_labels[k]);
+// The counts of the live aggregator's final message, in the order of `labels`.
+RunCounts recorded_counts(const dicesim_lcm::probabilities& m, const std::vector<int>& labels) {
+  RunCounts c(static_cast<int>(labels.size()));
+  for (std::size_t k = 0; k < m.labels.size() && k < m.counts.size(); ++k) {
+    const auto it = std::find(labels.begin(), labels.end(), m.labels[k]);
     if (it != labels.end() && m.counts[k] >= 0)
       c.faces[static_cast<std::size_t>(it - labels.begin())] = static_cast<std::uint64_t>(m.counts[k]);
   }
@@ -195,7 +199,7 @@ ReplayResult replay(const ReplayOptions& opt) {
   const dicesim_lcm::run_start start = find_run(opt.path, opt.run_id, opt.key);
   const Rebuilt rb = rebuild(start);
   res.spec = rb.spec;
-  res.labels = six_outcome_labels(rb.model);
+  res.labels = rb.spec.labels;
   res.model_matches = rb.matches;
   logging::set_run_id(rb.spec.run_id);
   spdlog::info("replaying run {}: {} ({}), seed {}, {} tosses", rb.spec.run_id, rb.spec.origin, rb.spec.fidelity,
@@ -203,7 +207,6 @@ ReplayResult replay(const ReplayOptions& opt) {
 
   agg::AggregatorConfig cfg;
   cfg.spec = rb.spec;
-  cfg.labels = six_outcome_labels(rb.model);
   cfg.key = opt.key;
   std::unique_ptr<lcm::LCM> bus;
   if (opt.live) {
@@ -217,7 +220,7 @@ ReplayResult replay(const ReplayOptions& opt) {
     // carry): its last message says where, S. The widest half-width at S, H* <= H, stops the
     // aggregator's own rule at exactly S: every earlier boundary was wider than H >= H*.
     res.stopped_at_target = true;
-    cfg.target_halfwidth = agg::max_halfwidth(recorded_counts(*res.recorded_final, six_outcome_labels(rb.model)));
+    cfg.target_halfwidth = agg::max_halfwidth(recorded_counts(*res.recorded_final, res.labels));
     spdlog::info("the live run stopped early at {} tosses (a target half-width); replaying to the same stop",
                  res.recorded_final->total);
     p = feed(opt, cfg, nullptr, res);
@@ -242,12 +245,11 @@ bool same_as_recorded(const ReplayResult& r) {
       m.unresolved != static_cast<std::int64_t>(r.counts.unresolved) ||
       m.invalid != static_cast<std::int64_t>(r.counts.invalid) || m.done != static_cast<std::int64_t>(r.tosses))
     return false;
-  for (int k = 0; k < 6; ++k) {
-    const auto it = std::find(r.labels.begin(), r.labels.end(), m.face_labels[k]);
-    if (it == r.labels.end()) return false;
-    if (m.counts[k] != static_cast<std::int64_t>(r.counts.faces[static_cast<std::size_t>(it - r.labels.begin())]))
-      return false;
-  }
+  // The same outcomes in the same (label) order, and the same count for each.
+  if (m.labels != std::vector<std::int32_t>(r.labels.begin(), r.labels.end()) || m.counts.size() != r.counts.faces.size())
+    return false;
+  for (std::size_t k = 0; k < m.counts.size(); ++k)
+    if (m.counts[k] != static_cast<std::int64_t>(r.counts.faces[k])) return false;
   return true;
 }
 
@@ -301,9 +303,13 @@ TossCheck check_toss(const std::string& path, std::int64_t run_id, std::uint64_t
       auto b = wire::decode<dicesim_lcm::toss_batch>(e->data, len);
       if (!b || b->run_id != rb.spec.run_id || b->first_index > want || want - b->first_index >= b->count) continue;
       const auto k = static_cast<std::size_t>(want - b->first_index);
-      if (k >= b->faces.size() || k >= b->statuses.size() || k >= b->bounces.size()) continue;
+      if (k >= b->outcomes.size() || k >= b->statuses.size() || k >= b->bounces.size()) continue;
       c.batch_found = true;
-      c.log_face = b->faces[k];
+      // The result is an outcome index: its label (-1: an index the run does not have).
+      const int o = b->outcomes[k];
+      c.log_face = b->statuses[k] != 0                                          ? 0
+                   : o >= 0 && static_cast<std::size_t>(o) < rb.spec.labels.size() ? rb.spec.labels[static_cast<std::size_t>(o)]
+                                                                                  : -1;
       c.log_status = b->statuses[k];
       c.log_bounces = b->bounces[k];
     }

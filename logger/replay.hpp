@@ -37,7 +37,7 @@ ReplayOptions default_replay_options();
 
 struct ReplayResult {
   wire::RunSpec spec;                // from run_start
-  std::array<int, 6> labels{};       // face label per face index (the rebuilt model's)
+  std::vector<int> labels;           // the run's outcome labels (run_start's), counts in this order
   bool model_matches = true;         // the model rebuilt here has the run's fingerprint
   RunCounts counts;                  // over toss indices [0, tosses)
   std::uint64_t tosses = 0;
@@ -69,7 +69,7 @@ struct TossCheck {
   std::vector<BounceRecord> simulated;
   TossResult sim;
   bool batch_found = false;                       // the log also holds the toss's result...
-  int log_face = 0, log_status = 0, log_bounces = 0;  // ...which is this
+  int log_face = 0, log_status = 0, log_bounces = 0;  // ...which is this (log_face: the outcome's label)
   double max_abs_diff = 0.0;                      // over every logged field, against the re-simulation
   bool bit_identical = false;
   bool agree = false;

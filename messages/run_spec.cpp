@@ -1,5 +1,6 @@
 #include "messages/run_spec.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -55,9 +56,29 @@ struct Fnv {
   }
 };
 
+bool is_mesh_override(const std::string& o) {
+  const std::size_t eq = o.find('=');
+  if (eq == std::string::npos) return false;
+  std::string key = o.substr(0, eq);
+  key.erase(0, key.find_first_not_of(" \t"));
+  key.erase(key.find_last_not_of(" \t") + 1);
+  return key == "die.mesh";
+}
+
+// A TOML basic string holding `s` (a path).
+std::string toml_quoted(const std::string& s) {
+  std::string q = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') q += '\\';
+    q += c;
+  }
+  return q + "\"";
+}
+
 }  // namespace
 
-std::vector<SceneFile> read_scene_files(const std::string& path) {
+std::vector<SceneFile> read_scene_files(const std::string& path, const std::vector<std::string>& asset_paths,
+                                        std::vector<SceneFile>* assets) {
   // Follow the extends chain as load_scene does (relative to each file's folder), at most 64 deep
   // (load_scene itself reports cycles).
   std::vector<fs::path> chain{fs::path(path)};
@@ -70,8 +91,13 @@ std::vector<SceneFile> read_scene_files(const std::string& path) {
     chain.push_back(base);
     texts.push_back(read_file(base));
   }
-  // Paths relative to the common ancestor of every file, so that the relative `extends` of each
-  // resolves the same way inside the worker's temporary copy.
+  const std::size_t n_scene = chain.size();
+  for (const std::string& a : asset_paths) {
+    chain.push_back(fs::path(a));
+    texts.push_back(read_file(a));
+  }
+  // Paths relative to the common ancestor of every file, so that the relative `extends` (and mesh
+  // path) of each resolves the same way inside the worker's temporary copy.
   std::vector<fs::path> abs;
   for (const fs::path& p : chain) abs.push_back(fs::weakly_canonical(fs::absolute(p)));
   fs::path root = abs[0].parent_path();
@@ -79,8 +105,24 @@ std::vector<SceneFile> read_scene_files(const std::string& path) {
     while (!root.empty() && std::mismatch(root.begin(), root.end(), p.begin(), p.end()).first != root.end())
       root = root.parent_path();
   std::vector<SceneFile> files;
-  for (std::size_t i = 0; i < abs.size(); ++i) files.push_back({fs::relative(abs[i], root).generic_string(), texts[i]});
+  for (std::size_t i = 0; i < abs.size(); ++i) {
+    SceneFile f{fs::relative(abs[i], root).generic_string(), texts[i]};
+    if (i < n_scene) files.push_back(std::move(f));
+    else if (assets) assets->push_back(std::move(f));
+  }
   return files;
+}
+
+void check_wire_outcomes(const DieModel& m, const std::string& origin) {
+  std::vector<std::int32_t> labels(m.outcome_labels.begin(), m.outcome_labels.end());
+  if (valid_outcome_labels(labels)) return;
+  const auto [lo, hi] = std::minmax_element(m.outcome_labels.begin(), m.outcome_labels.end());
+  throw SceneError(origin, "die", std::to_string(m.outcomes()) + " outcomes" +
+                                      (m.outcome_labels.empty() ? std::string()
+                                                                : ", labels " + std::to_string(*lo) + ".." + std::to_string(*hi)),
+                   "distributed runs (run, aggregate, sweep --workers) carry 1 to " + std::to_string(kMaxOutcomes) +
+                       " outcomes with labels in [0, " + std::to_string(kMaxLabel) +
+                       "]: group faces with [[die.labels]], or use `dicesim toss`");
 }
 
 std::string scene_hash(const std::vector<SceneFile>& files, const std::vector<std::string>& overrides) {
@@ -100,6 +142,9 @@ std::uint64_t model_fingerprint(const DieModel& m) {
   for (const Vec3& v : m.vertices) f.vec(v);
   for (const Vec3& v : m.face_normals) f.vec(v);
   for (int l : m.face_labels) f.u64(static_cast<std::uint64_t>(l));
+  for (int l : m.outcome_labels) f.u64(static_cast<std::uint64_t>(l));
+  f.u64(m.read_down);
+  f.d(m.rounding);
   for (double r : m.vertex_restitution) f.d(r);
   for (double r : m.vertex_friction) f.d(r);
   f.d(m.bounding_radius);
@@ -129,7 +174,9 @@ std::uint64_t model_fingerprint(const DieModel& m) {
 
 DieModel compile_spec(const RunSpec& spec) {
   if (spec.files.empty()) throw SceneError(spec.origin, "", "", "run_start carries no scene file");
-  for (const SceneFile& s : spec.files) {
+  std::vector<SceneFile> all = spec.files;
+  all.insert(all.end(), spec.assets.begin(), spec.assets.end());
+  for (const SceneFile& s : all) {
     const fs::path p(s.path);
     if (p.empty() || p.is_absolute())
       throw SceneError(spec.origin, "", s.path, "run_start file paths must be relative");
@@ -146,14 +193,18 @@ DieModel compile_spec(const RunSpec& spec) {
       fs::remove_all(d, ec);
     }
   } cleanup{dir};
-  for (const SceneFile& s : spec.files) {
+  for (const SceneFile& s : all) {
     const fs::path p = dir / s.path;
     fs::create_directories(p.parent_path());
     std::ofstream(p, std::ios::binary) << s.text;
   }
+  // A mesh named by --set die.mesh=PATH was relative to the user's folder: it is the asset here.
+  std::vector<std::string> overrides = spec.overrides;
+  for (std::string& o : overrides)
+    if (is_mesh_override(o) && !spec.assets.empty()) o = "die.mesh=" + toml_quoted((dir / spec.assets.back().path).string());
   // The scene's name comes from the file's stem, as in `toss`; errors name the user's path.
   const fs::path main = dir / spec.files[0].path;
-  return compile(load_scene(main.string(), spec.overrides), spec.origin);
+  return compile(load_scene(main.string(), overrides), spec.origin);
 }
 
 RunSpec make_run_spec(std::int64_t run_id, const std::string& scene_path, const std::vector<std::string>& overrides,
@@ -161,14 +212,22 @@ RunSpec make_run_spec(std::int64_t run_id, const std::string& scene_path, const 
   RunSpec spec;
   spec.run_id = run_id;
   spec.origin = scene_path;
-  spec.files = read_scene_files(scene_path);
   spec.overrides = overrides;
   spec.fidelity = to_string(model.fidelity);
   spec.seed = seed;
   spec.total = total;
   spec.trace_every = trace_every;
   spec.fingerprint = model_fingerprint(model);
-  spec.hash = scene_hash(spec.files, overrides);
+  check_wire_outcomes(model, scene_path);
+  spec.labels = model.outcome_labels;
+  // A mesh die reads an OBJ file: it travels in run_start with the scene files.
+  const SceneDef def = load_scene(scene_path, overrides);
+  std::vector<std::string> asset_paths;
+  if (!def.die.mesh_path.empty()) asset_paths.push_back(def.die.mesh_path);
+  spec.files = read_scene_files(scene_path, asset_paths, &spec.assets);
+  std::vector<SceneFile> hashed = spec.files;
+  hashed.insert(hashed.end(), spec.assets.begin(), spec.assets.end());
+  spec.hash = scene_hash(hashed, overrides);
   // What a worker will do with run_start, done here first: a run no worker could rebuild fails now.
   if (model_fingerprint(compile_spec(spec)) != spec.fingerprint)
     throw std::runtime_error("the scene does not rebuild identically from its files (run_start)");
@@ -202,6 +261,13 @@ dicesim_lcm::run_start to_message(const RunSpec& spec) {
   m.seed = static_cast<std::int64_t>(spec.seed);
   m.total_tosses = static_cast<std::int64_t>(spec.total);
   m.trace_every = spec.trace_every;
+  m.outcome_labels.assign(spec.labels.begin(), spec.labels.end());
+  m.n_outcomes = static_cast<std::int32_t>(m.outcome_labels.size());
+  for (const SceneFile& a : spec.assets) {
+    m.asset_paths.push_back(a.path);
+    m.asset_texts.push_back(a.text);
+  }
+  m.n_assets = static_cast<std::int32_t>(m.asset_paths.size());
   return m;
 }
 
@@ -219,6 +285,9 @@ RunSpec from_message(const dicesim_lcm::run_start& m) {
   s.trace_every = m.trace_every;
   s.fingerprint = static_cast<std::uint64_t>(m.model_fingerprint);
   s.hash = m.scene_hash;
+  s.labels.assign(m.outcome_labels.begin(), m.outcome_labels.end());
+  for (std::size_t i = 0; i < m.asset_paths.size() && i < m.asset_texts.size(); ++i)
+    s.assets.push_back({m.asset_paths[i], m.asset_texts[i]});
   return s;
 }
 

@@ -29,10 +29,18 @@ struct RunSpec {
   int trace_every = 0;
   std::uint64_t fingerprint = 0;   // model_fingerprint of the compiled model
   std::string hash;                // scene_hash()
+  std::vector<int> labels;         // the model's outcome_labels: results are indices into these
+  std::vector<SceneFile> assets;   // files the scene reads besides TOML (a mesh's OBJ), same root as files
 };
 
+// The die fits the wire: 1 to kMaxOutcomes outcomes, labels in [0, kMaxLabel] (messages/wire.hpp).
+// Throws SceneError naming `origin`, the outcome count and the limit otherwise.
+void check_wire_outcomes(const DieModel& m, const std::string& origin);
+
 // Reads `path` and the files it extends (throws SceneError if unreadable). Does not compile.
-std::vector<SceneFile> read_scene_files(const std::string& path);
+// `asset_paths` (e.g. a mesh's OBJ) are read too, into `assets`, relative to the same root.
+std::vector<SceneFile> read_scene_files(const std::string& path, const std::vector<std::string>& asset_paths = {},
+                                        std::vector<SceneFile>* assets = nullptr);
 
 // FNV-1a 64 over every path, text and override (hex): names the exact input of a run.
 std::string scene_hash(const std::vector<SceneFile>& files, const std::vector<std::string>& overrides);

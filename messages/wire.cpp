@@ -65,7 +65,42 @@ bool plausible_run_start(const void* data, std::size_t len) {
   if (!w.count(n, 5)) return false;
   for (std::int32_t i = 0; i < n; ++i)
     if (!w.str()) return false;
-  return w.str() && w.skip(8) && w.str() && w.skip(8 + 8 + 4) && w.at_end();
+  // hash fingerprint fidelity seed total trace_every; then the outcomes and the assets
+  if (!w.str() || !w.skip(8) || !w.str() || !w.skip(8 + 8 + 4)) return false;
+  if (!w.count(n, 4) || n < 1 || n > kMaxOutcomes || !w.skip(static_cast<std::size_t>(n) * 4)) return false;
+  if (!w.count(n, 10)) return false;
+  for (int pass = 0; pass < 2; ++pass)
+    for (std::int32_t i = 0; i < n; ++i)
+      if (!w.str()) return false;
+  return w.at_end();
+}
+
+bool plausible_probabilities(const void* data, std::size_t len) {
+  Walker w(data, len);
+  std::int32_t n = 0;
+  // hash utime run_id; n labels (4) + counts p ci_lo ci_hi (8 each); then 133 bytes of scalars
+  return w.skip(8 + 8 + 8) && w.count(n, 36) && n >= 1 && n <= kMaxOutcomes && w.skip(static_cast<std::size_t>(n) * 36) &&
+         w.skip(133) && w.at_end();
+}
+
+bool valid_outcome_labels(const std::vector<std::int32_t>& labels) {
+  if (labels.empty() || labels.size() > static_cast<std::size_t>(kMaxOutcomes)) return false;
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (labels[i] < 0 || labels[i] > kMaxLabel || (i > 0 && labels[i] <= labels[i - 1])) return false;
+  return true;
+}
+
+const char* legacy_format(const void* data, std::size_t len) {
+  if (len < 8) return nullptr;
+  std::uint64_t h = 0;
+  for (int i = 0; i < 8; ++i) h = (h << 8) | static_cast<const std::uint8_t*>(data)[i];
+  // lcm-gen's hashes of the six-outcome types (dicesim before the wire carried N outcomes).
+  switch (h) {
+    case 0x16854fcd47c16d6eULL: return "run_start of the six-outcome wire (no outcome labels)";
+    case 0x5196dd2e391cfd23ULL: return "toss_batch of the six-outcome wire (faces 1..6)";
+    case 0xefc6a3d437de62eaULL: return "probabilities of the six-outcome wire ([6] arrays)";
+    default: return nullptr;
+  }
 }
 
 bool plausible_toss_batch(const void* data, std::size_t len) {

@@ -33,12 +33,27 @@ std::string resolve_url(const std::string& flag);
 // A toss_batch carries at most this many tosses: 6 bytes each, ~12 KB, one datagram.
 inline constexpr int kMaxBatch = 2048;
 
+// A die's outcomes on the wire (run_start, probabilities): 1 to kMaxOutcomes labels, ascending,
+// each in [0, kMaxLabel]. A toss result is an index into them (int8: kMaxOutcomes must stay < 128).
+// A message that claims more is not decoded (rejected and counted by its receiver).
+inline constexpr int kMaxOutcomes = 120;
+inline constexpr int kMaxLabel = 999;
+static_assert(kMaxOutcomes < 128, "toss_batch.outcomes is int8");
+// Are these labels a valid outcome list (count, range, strictly ascending)?
+bool valid_outcome_labels(const std::vector<std::int32_t>& labels);
+
+// Messages recorded before a die could have any number of outcomes (toss_batch faces 1..6,
+// fixed [6] arrays in probabilities, run_start without outcome labels) have other LCM type
+// hashes and never decode as today's types. Names the old type if `data` is one, else nullptr.
+const char* legacy_format(const void* data, std::size_t len);
+
 // Counted arrays in lcm-gen's decoders are resized before their bytes are checked, so a hostile
 // count could allocate gigabytes. These walk the encoding first and accept only payloads whose
 // every count and length fits inside the bytes given.
 bool plausible_run_start(const void* data, std::size_t len);
 bool plausible_toss_batch(const void* data, std::size_t len);
 bool plausible_worker_status(const void* data, std::size_t len);
+bool plausible_probabilities(const void* data, std::size_t len);
 
 template <class T>
 bool plausible(const void*, std::size_t) {
@@ -48,6 +63,10 @@ template <>
 inline bool plausible<dicesim_lcm::run_start>(const void* d, std::size_t n) { return plausible_run_start(d, n); }
 template <>
 inline bool plausible<dicesim_lcm::toss_batch>(const void* d, std::size_t n) { return plausible_toss_batch(d, n); }
+template <>
+inline bool plausible<dicesim_lcm::probabilities>(const void* d, std::size_t n) {
+  return plausible_probabilities(d, n);
+}
 template <>
 inline bool plausible<dicesim_lcm::worker_status>(const void* d, std::size_t n) {
   return plausible_worker_status(d, n);

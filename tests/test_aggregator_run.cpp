@@ -85,7 +85,7 @@ struct Fixture {
     model = wire::compile_spec(spec);
     spec.fingerprint = wire::model_fingerprint(model);
     cfg.spec = spec;
-    cfg.labels = six_outcome_labels(model);
+    cfg.spec.labels = spec.labels = model.outcome_labels;
     cfg.max_lease = 700;
     cfg.min_lease = 150;
     cfg.target_halfwidth = target;
@@ -186,10 +186,10 @@ TEST(AggregatorRun, TargetStopsAtTheSameBlockAsInOrderTossing) {
 TEST(AggregatorRun, ForeignAndMalformedBatchesAreCountedAndIgnored) {
   Fixture f(2000);
   Net net = make_net(f, 1);
-  auto batch = [](std::int64_t run, std::int64_t first, int n, int face, int status) {
+  auto batch = [](std::int64_t run, std::int64_t first, int n, int outcome, int status) {
     dicesim_lcm::toss_batch b{};
     b.run_id = run, b.worker_id = 1, b.lease_id = 1, b.first_index = first, b.count = n;
-    b.faces.assign(static_cast<std::size_t>(n), static_cast<std::int8_t>(face));
+    b.outcomes.assign(static_cast<std::size_t>(n), static_cast<std::int8_t>(outcome));
     b.statuses.assign(static_cast<std::size_t>(n), static_cast<std::int8_t>(status));
     b.bounces.assign(static_cast<std::size_t>(n), 2);
     return wire::encode(b);
@@ -198,10 +198,25 @@ TEST(AggregatorRun, ForeignAndMalformedBatchesAreCountedAndIgnored) {
   feed(batch(999, 0, 10, 1, 0));    // foreign
   feed(batch(1234, 1995, 10, 1, 0));  // past the end
   feed(batch(1234, -1, 10, 1, 0));  // negative
-  feed(batch(1234, 0, 10, 7, 0));   // face 7
-  feed(batch(1234, 0, 10, 0, 0));   // settled on face 0
-  feed(batch(1234, 0, 10, 3, 2));   // invalid toss with a face
-  feed(batch(1234, 0, 10, 0, 5));   // status 5
+  feed(batch(1234, 0, 10, 6, 0));   // outcome index 6 of a die with 6 outcomes (0..5)
+  feed(batch(1234, 0, 10, -1, 0));  // settled on no outcome
+  feed(batch(1234, 0, 10, 3, 2));   // invalid toss with an outcome
+  feed(batch(1234, 0, 10, -1, 5));  // status 5
+  feed(batch(1234, 0, 10, 19, 0));  // a d20's outcome in a d6 run
+  // Messages claiming more outcomes than the wire carries (120): not decoded, counted.
+  dicesim_lcm::probabilities many{};
+  many.run_id = 1234;
+  many.n_outcomes = 121;
+  for (int i = 0; i < 121; ++i) many.labels.push_back(i);
+  many.counts.assign(121, 0);
+  many.p = many.ci_lo = many.ci_hi = std::vector<double>(121, 0.0);
+  const auto mb = wire::encode(many);
+  net.agg->on_message(wire::kProbabilities, mb.data(), mb.size(), 0.0);
+  dicesim_lcm::run_start rs = wire::to_message(f.cfg.spec);
+  rs.n_outcomes = 121;
+  rs.outcome_labels = many.labels;
+  const auto rb = wire::encode(rs);
+  net.agg->on_message(wire::kRunStart, rb.data(), rb.size(), 0.0);
   auto good = batch(1234, 0, 10, 1, 0);
   feed(std::vector<std::uint8_t>(good.begin(), good.end() - 1));  // truncated
   good.push_back(0);
@@ -212,7 +227,7 @@ TEST(AggregatorRun, ForeignAndMalformedBatchesAreCountedAndIgnored) {
   const auto& h = net.agg->health();
   EXPECT_EQ(h.foreign, 1u);
   EXPECT_EQ(h.range, 2u);
-  EXPECT_EQ(h.malformed, 7u);
+  EXPECT_EQ(h.malformed, 10u);
   EXPECT_EQ(net.agg->received(), 0u);
   ASSERT_TRUE(net.run());
   EXPECT_EQ(net.agg->result(), f.reference(2000));

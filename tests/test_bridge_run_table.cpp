@@ -52,26 +52,36 @@ TEST(BridgeTranslate, EveryFieldCrosses) {
   dicesim_lcm::probabilities m{};
   m.utime = 17;
   m.run_id = 42;
-  for (int f = 0; f < 6; ++f) {
-    m.face_labels[f] = f + 1;
-    m.counts[f] = 100 + f;
-    m.p[f] = 0.1 + f * 0.01;
-    m.ci_lo[f] = 0.05 + f * 0.01;
-    m.ci_hi[f] = 0.15 + f * 0.01;
+  // A d20's answer: every outcome crosses, in order.
+  m.n_outcomes = 20;
+  for (int f = 0; f < 20; ++f) {
+    m.labels.push_back(f + 1);
+    m.counts.push_back(100 + f);
+    m.p.push_back(0.1 + f * 0.01);
+    m.ci_lo.push_back(0.05 + f * 0.01);
+    m.ci_hi.push_back(0.15 + f * 0.01);
   }
   m.settled = 615, m.unresolved = 3, m.invalid = 2, m.done = 620, m.total = 1000;
   m.tosses_per_s = 123.5, m.finished = 1, m.workers = 3;
   m.duplicates = 4, m.rejected_foreign = 5, m.rejected_malformed = 6, m.rejected_range = 7, m.released = 8;
-  const dicesim_dds_probabilities s = b::to_dds(m);
+  m.rejected_unauthenticated = 9;
+  const dicesim_dds_probabilities_v2 s = b::to_dds(m);
   EXPECT_EQ(s.run_id, 42);
   EXPECT_EQ(s.utime, 17);
-  for (int f = 0; f < 6; ++f) {
-    EXPECT_EQ(s.face_labels[f], f + 1);
-    EXPECT_EQ(s.counts[f], 100 + f);
-    EXPECT_EQ(s.p[f], m.p[f]);
-    EXPECT_EQ(s.ci_lo[f], m.ci_lo[f]);
-    EXPECT_EQ(s.ci_hi[f], m.ci_hi[f]);
+  ASSERT_EQ(s.labels._length, 20u);
+  ASSERT_EQ(s.counts._length, 20u);
+  ASSERT_EQ(s.p._length, 20u);
+  ASSERT_EQ(s.ci_lo._length, 20u);
+  ASSERT_EQ(s.ci_hi._length, 20u);
+  EXPECT_FALSE(s.labels._release);  // borrowed from m: Cyclone must not free it
+  for (std::size_t f = 0; f < 20; ++f) {
+    EXPECT_EQ(s.labels._buffer[f], static_cast<int>(f) + 1);
+    EXPECT_EQ(s.counts._buffer[f], 100 + static_cast<int>(f));
+    EXPECT_EQ(s.p._buffer[f], m.p[f]);
+    EXPECT_EQ(s.ci_lo._buffer[f], m.ci_lo[f]);
+    EXPECT_EQ(s.ci_hi._buffer[f], m.ci_hi[f]);
   }
+  EXPECT_EQ(s.rejected_unauthenticated, 9);
   EXPECT_EQ(s.settled, 615);
   EXPECT_EQ(s.unresolved, 3);
   EXPECT_EQ(s.invalid, 2);

@@ -12,7 +12,7 @@ TEST(LcmFuzzSmoke, MutatedMessagesOnEveryChannel) {
   fuzz::Handlers h;
   dicesim_lcm::toss_batch b{};
   b.run_id = 77, b.first_index = 10, b.count = 4;
-  b.faces = {1, 2, 0, 6};
+  b.outcomes = {0, 1, -1, 5};
   b.statuses = {0, 0, 1, 0};
   b.bounces = {1, 2, 3, 4};
   dicesim_lcm::worker_status s{};
@@ -21,6 +21,10 @@ TEST(LcmFuzzSmoke, MutatedMessagesOnEveryChannel) {
   l.run_id = 77, l.worker_id = 5, l.lease_id = 1, l.first_index = 0, l.count = 10;
   dicesim_lcm::probabilities p{};
   p.run_id = 77;
+  p.n_outcomes = 6;
+  p.labels = {1, 2, 3, 4, 5, 6};
+  p.counts.assign(6, 0);
+  p.p = p.ci_lo = p.ci_hi = std::vector<double>(6, 0.0);
   const std::vector<std::vector<std::uint8_t>> seeds = {wire::encode(b), wire::encode(s), wire::encode(l), wire::encode(p),
                                                          wire::encode(dicesim_lcm::bounce_state{})};
   std::mt19937 rng(2024);

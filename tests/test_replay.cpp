@@ -70,7 +70,6 @@ Written write_log(const std::string& path, const LogPlan& plan) {
   };
   dicesim::agg::AggregatorConfig cfg;
   cfg.spec = spec;
-  cfg.labels = dicesim::six_outcome_labels(model);
   cfg.target_halfwidth = plan.target_halfwidth;
   std::vector<std::vector<std::uint8_t>> finals;
   dicesim::agg::Aggregator live(cfg, [&](const char* ch, const std::vector<std::uint8_t>& bytes) {
@@ -99,7 +98,7 @@ Written write_log(const std::string& path, const LogPlan& plan) {
       probe.trace = &recs;
       const bool traced = plan.trace_every > 0 && i % static_cast<std::uint64_t>(plan.trace_every) == 0;
       const dicesim::TossResult r = dicesim::toss(model, plan.seed, i, traced ? &probe : nullptr);
-      b.faces.push_back(static_cast<std::int8_t>(r.status == dicesim::TossStatus::Settled ? r.face : 0));
+      b.outcomes.push_back(static_cast<std::int8_t>(r.status == dicesim::TossStatus::Settled ? r.outcome : -1));
       b.statuses.push_back(static_cast<std::int8_t>(r.status));
       b.bounces.push_back(r.bounces);
       for (const dicesim::BounceRecord& rec : recs) {  // as sim/worker publishes them

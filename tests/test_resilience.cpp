@@ -123,7 +123,7 @@ struct TestRun {
     spec.total = total;
     model = wire::compile_spec(spec);
     spec.fingerprint = wire::model_fingerprint(model);
-    cfg.labels = six_outcome_labels(model);
+    spec.labels = model.outcome_labels;
     cfg.max_lease = 700;
     cfg.min_lease = 150;
   }
@@ -142,7 +142,7 @@ dicesim_lcm::toss_batch forged_batch(std::int64_t run, std::int64_t first, int n
   b.lease_id = 1;
   b.first_index = first;
   b.count = n;
-  b.faces.assign(static_cast<std::size_t>(n), 6);  // a face label of die1, settled
+  b.outcomes.assign(static_cast<std::size_t>(n), 5);  // label 6 of die1, settled
   b.statuses.assign(static_cast<std::size_t>(n), 0);
   b.bounces.assign(static_cast<std::size_t>(n), 1);
   return b;

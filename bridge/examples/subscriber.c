@@ -1,6 +1,7 @@
 /* An external subscriber to a dicesim run over DDS: plain C, the Cyclone DDS C API and the
  * types idlc generates from dicesim's messages/ IDL files -- nothing else of dicesim. Prints one line
- * per sample of `dicesim_probabilities` and `dicesim_run_status`.
+ * per sample of `dicesim_probabilities` (type dicesim_dds::probabilities_v2: any number of outcomes,
+ * as bounded sequences) and `dicesim_run_status`.
  *
  *   dicesim_dds_subscriber [--json] [--topic probabilities|status|both] [--run ID]
  *                          [--count N] [--until-finished] [--timeout S]
@@ -48,22 +49,27 @@ static const char* state_name(dicesim_dds_run_state s) {
 }
 
 /* rx_utime - utime is the latency from the aggregator (same host, same clock). */
-static void print_probabilities(const dicesim_dds_probabilities* m, int json, int64_t rx) {
-  int f;
+static void print_probabilities(const dicesim_dds_probabilities_v2* m, int json, int64_t rx) {
+  uint32_t f, n = m->labels._length;
+  /* The sequences have one entry per outcome; a sample whose lengths differ prints the common part. */
+  if (m->counts._length < n) n = m->counts._length;
+  if (m->p._length < n) n = m->p._length;
+  if (m->ci_lo._length < n) n = m->ci_lo._length;
+  if (m->ci_hi._length < n) n = m->ci_hi._length;
   if (json) {
     printf("{\"topic\":\"dicesim_probabilities\",\"run_id\":%" PRId64 ",\"utime\":%" PRId64 ",\"rx_utime\":%" PRId64
            ",\"done\":%" PRId64 ",\"total\":%" PRId64 ",\"finished\":%s,\"settled\":%" PRId64
            ",\"unresolved\":%" PRId64 ",\"invalid\":%" PRId64 ",\"workers\":%d,\"faces\":[",
            m->run_id, m->utime, rx, m->done, m->total, m->finished ? "true" : "false", m->settled, m->unresolved,
            m->invalid, m->workers);
-    for (f = 0; f < 6; ++f)
+    for (f = 0; f < n; ++f)
       printf("%s{\"face\":%d,\"count\":%" PRId64 ",\"p\":%.17g,\"ci95\":[%.17g,%.17g]}", f ? "," : "",
-             m->face_labels[f], m->counts[f], m->p[f], m->ci_lo[f], m->ci_hi[f]);
+             m->labels._buffer[f], m->counts._buffer[f], m->p._buffer[f], m->ci_lo._buffer[f], m->ci_hi._buffer[f]);
     printf("]}\n");
   } else {
     printf("run %" PRId64 " %s %" PRId64 "/%" PRId64 " tosses, %d workers |", m->run_id,
            m->finished ? "FINISHED" : "running", m->done, m->total, m->workers);
-    for (f = 0; f < 6; ++f) printf(" %d: %.4f", m->face_labels[f], m->p[f]);
+    for (f = 0; f < n; ++f) printf(" %d: %.4f", m->labels._buffer[f], m->p._buffer[f]);
     printf(" | %.1f ms after publish\n", (double)(rx - m->utime) / 1000.0);
   }
 }
@@ -134,7 +140,7 @@ int main(int argc, char** argv) {
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
   dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
   dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
-  topics[0] = dds_create_topic(participant, &dicesim_dds_probabilities_desc, "dicesim_probabilities", qos, NULL);
+  topics[0] = dds_create_topic(participant, &dicesim_dds_probabilities_v2_desc, "dicesim_probabilities", qos, NULL);
   topics[1] = dds_create_topic(participant, &dicesim_dds_run_status_desc, "dicesim_run_status", qos, NULL);
   waitset = dds_create_waitset(participant);
   for (i = 0; i < 2; ++i) {
@@ -169,7 +175,7 @@ int main(int argc, char** argv) {
         const int64_t rx = now_utime();
         if (!infos[k].valid_data) continue; /* a disposed or unregistered run */
         if (i == 0) {
-          const dicesim_dds_probabilities* m = samples[k];
+          const dicesim_dds_probabilities_v2* m = samples[k];
           if (run_filter && m->run_id != run_filter) continue;
           print_probabilities(m, json, rx);
           if (until_finished && m->finished) done = 1;

@@ -97,6 +97,9 @@ void WorkerCore::on_run_start(const dicesim_lcm::run_start& m, double now) {
     if (wire::model_fingerprint(model) != run_->spec.fingerprint)
       throw std::runtime_error("the model compiled here differs from the aggregator's (fingerprint mismatch: "
                                "a different dicesim build?)");
+    // Results go out as indices into run_start's outcome list: it must be this model's.
+    if (model.outcome_labels != run_->spec.labels)
+      throw std::runtime_error("the die compiled here has other outcome labels than run_start announces");
     run_->model = std::move(model);
   } catch (const std::exception& e) {  // SceneError or anything else: refuse, say why
     run_->error = e.what();
@@ -184,7 +187,7 @@ bool WorkerCore::step(double now) {
   b.lease_id = l.id;
   b.first_index = static_cast<std::int64_t>(l.next);
   b.count = static_cast<std::int32_t>(n);
-  b.faces.resize(n);
+  b.outcomes.resize(n);
   b.statuses.resize(n);
   b.bounces.resize(n);
   b.n_corrected = 0;
@@ -197,7 +200,7 @@ bool WorkerCore::step(double now) {
     probe.trace = &records;
     // The probe only records: the result is the same toss as without it.
     const TossResult r = toss(model, spec.seed, i, traced ? &probe : nullptr);
-    b.faces[k] = static_cast<std::int8_t>(r.status == TossStatus::Settled ? r.face : 0);
+    b.outcomes[k] = static_cast<std::int8_t>(r.status == TossStatus::Settled ? r.outcome : -1);
     b.statuses[k] = static_cast<std::int8_t>(r.status);
     b.bounces[k] = r.bounces;
     if (r.corrections.any()) {

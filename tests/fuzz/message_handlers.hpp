@@ -25,7 +25,7 @@ struct Handlers {
     cfg.spec.total = 100000;
     cfg.spec.seed = 1;
     cfg.spec.files = {{"die.toml", "name = 'x'"}};
-    cfg.labels = {2, 5, 3, 4, 1, 6};
+    cfg.spec.labels = {1, 2, 3, 4, 5, 6};
     auto sink = [](const char*, const std::vector<std::uint8_t>&) {};
     agg = std::make_unique<agg::Aggregator>(cfg, sink);
     worker::WorkerConfig wc;

@@ -13,6 +13,12 @@ bin=$1 sub=$2 inject=$3 scenario=$4
 
 scene=scenes/paper/die1.toml
 seed=11
+# A scenario name ending in _d20 or _d4 runs the same scenario on that die (scenes/dice/):
+# everything that works for a d6 works for any number of outcomes.
+case "$scenario" in
+  *_d20) scene=scenes/dice/d20.toml; scenario=${scenario%_d20} ;;
+  *_d4) scene=scenes/dice/d4.toml; scenario=${scenario%_d4} ;;
+esac
 fail() {
   echo "FAIL [$scenario]: $*" >&2
   for f in "$work"/*.err "$work"/*.jsonl; do [ -f "$f" ] && { echo "--- $f" >&2; tail -n 15 "$f" >&2; }; done
@@ -105,7 +111,7 @@ case "$scenario" in
     sleep 0.3
     subscriber --topic status --count 1 --timeout 2 > "$work/status.jsonl" || fail "no run status"
     grep -qF "\"run_id\":$run," "$work/status.jsonl" || fail "run status of another run: $(cat "$work/status.jsonl")"
-    jq -e '.state == "finished" and .origin == "scenes/paper/die1.toml" and .seed == 11 and .total_tosses == 400000' \
+    jq -e --arg scene "$scene" '.state == "finished" and .origin == $scene and .seed == 11 and .total_tosses == 400000' \
       "$work/status.jsonl" > /dev/null || fail "run status is not finished/complete: $(cat "$work/status.jsonl")"
     stops_cleanly TERM
     ;;

@@ -5,9 +5,9 @@
 //                             returns 0 as soon as a running run has done >= FRACTION of its
 //                             tosses (from DICESIM_PROBABILITIES); 1 if it finished or time ran out
 //   lcm_inject forge          a forger who knows the run id (from run_start, seal stripped) but not
-//                             the key: publishes toss_batch messages claiming face 6 for every index
+//                             the key: publishes toss_batch messages claiming the last outcome for every index
 //                             (from the top, so they come before the workers' results), unsealed,
-//                             sealed with a wrong key, and genuine sealed batches with their faces
+//                             sealed with a wrong key, and genuine sealed batches with their outcomes
 //                             changed; plus `finished` probabilities and a run_start with another
 //                             seed, to stop or mislead the workers. Prints how many of each it sent.
 //   lcm_inject count CHANNEL SECONDS
@@ -88,14 +88,14 @@ void send_raw(lcm::LCM& bus, const char* ch, const std::vector<std::uint8_t>& b,
   std::this_thread::sleep_for(std::chrono::milliseconds(2));
 }
 
-dicesim_lcm::toss_batch batch(std::int64_t run, std::int64_t first, int n, int face, int status) {
+dicesim_lcm::toss_batch batch(std::int64_t run, std::int64_t first, int n, int outcome, int status) {
   dicesim_lcm::toss_batch b{};
   b.run_id = run;
   b.worker_id = 42;
   b.lease_id = 1;
   b.first_index = first;
   b.count = n;
-  b.faces.assign(static_cast<std::size_t>(n), static_cast<std::int8_t>(face));
+  b.outcomes.assign(static_cast<std::size_t>(n), static_cast<std::int8_t>(outcome));
   b.statuses.assign(static_cast<std::size_t>(n), static_cast<std::int8_t>(status));
   b.bounces.assign(static_cast<std::size_t>(n), 3);
   return b;
@@ -124,11 +124,25 @@ int hostile(lcm::LCM& bus, Listener& in) {
   send(bus, w::kTossBatch, batch(run, total, 10, 1, 0), &range);
   send(bus, w::kTossBatch, batch(run, total - 5, 10, 1, 0), &range);
   send(bus, w::kTossBatch, batch(run, -3, 10, 1, 0), &range);
-  // Fields outside their domain: face 0 or 7 when settled, a face when unresolved, status 3.
-  send(bus, w::kTossBatch, batch(run, 0, 10, 0, 0), &malformed);
-  send(bus, w::kTossBatch, batch(run, 0, 10, 7, 0), &malformed);
+  // Fields outside their domain: no outcome or one past the die's when settled, an outcome when
+  // unresolved, status 3.
+  const int outcomes = in.run.n_outcomes;
+  send(bus, w::kTossBatch, batch(run, 0, 10, -1, 0), &malformed);
+  send(bus, w::kTossBatch, batch(run, 0, 10, outcomes, 0), &malformed);
   send(bus, w::kTossBatch, batch(run, 0, 10, 2, 1), &malformed);
-  send(bus, w::kTossBatch, batch(run, 0, 10, 0, 3), &malformed);
+  send(bus, w::kTossBatch, batch(run, 0, 10, -1, 3), &malformed);
+  // Claims of more outcomes than the wire carries (kMaxOutcomes): an answer and a run_start.
+  dicesim_lcm::probabilities many{};
+  many.run_id = run;
+  many.n_outcomes = w::kMaxOutcomes + 1;
+  for (int i = 0; i < many.n_outcomes; ++i) many.labels.push_back(i);
+  many.counts.assign(many.labels.size(), 0);
+  many.p = many.ci_lo = many.ci_hi = std::vector<double>(many.labels.size(), 0.0);
+  send(bus, w::kProbabilities, many, &malformed);
+  dicesim_lcm::run_start wide = in.run;
+  wide.n_outcomes = many.n_outcomes;
+  wide.outcome_labels = many.labels;
+  send(bus, w::kRunStart, wide, &malformed);
   // Truncated encodings of a valid message, and garbage, on every channel.
   std::mt19937 rng(12345);
   const auto good = w::encode(batch(run, 0, 10, 1, 0));
@@ -165,11 +179,11 @@ int forge(lcm::LCM& bus, Listener& in) {
   for (auto& b : wrong_key) b = static_cast<std::uint8_t>(rng());
   w::Sealer wrong(wrong_key);
   int unsealed = 0, wrong_sealed = 0, tampered = 0, to_workers = 0;
-  // Every index claimed as face 6 (a settled toss), top down: the workers start at index 0.
+  // Every index claimed as the die's last outcome (a settled toss), top down: the workers start at index 0.
   for (std::int64_t first = total; first > 0;) {
     const int n = static_cast<int>(std::min<std::int64_t>(w::kMaxBatch, first));
     first -= n;
-    auto bytes = w::encode(batch(run, first, n, 6, 0));
+    auto bytes = w::encode(batch(run, first, n, in.run.n_outcomes - 1, 0));
     send_raw(bus, w::kTossBatch, bytes, &unsealed);
     wrong.seal(w::kTossBatch, bytes);
     send_raw(bus, w::kTossBatch, bytes, &wrong_sealed);
@@ -190,6 +204,10 @@ int forge(lcm::LCM& bus, Listener& in) {
   fin.run_id = run;
   fin.finished = 1;
   fin.total = total;
+  fin.n_outcomes = in.run.n_outcomes;
+  fin.labels = in.run.outcome_labels;
+  fin.counts.assign(fin.labels.size(), 0);
+  fin.p = fin.ci_lo = fin.ci_hi = std::vector<double>(fin.labels.size(), 0.0);
   dicesim_lcm::run_start other = in.run;
   other.seed += 1;
   for (int k = 0; k < 5; ++k) {
@@ -201,9 +219,10 @@ int forge(lcm::LCM& bus, Listener& in) {
   }
   for (int k = 0; k < 20; ++k) {
     std::vector<std::uint8_t> t = in.captured;
-    // Payload: hash 8, utime run worker lease first 5x8, count 4, then faces (count bytes).
-    const std::size_t face0 = 8 + 5 * 8 + 4;
-    t[face0 + static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(t[face0 + static_cast<std::size_t>(k)] % 6 + 1);
+    // Payload: hash 8, utime run worker lease first 5x8, count 4, then outcomes (count bytes):
+    // another valid outcome index.
+    const std::size_t o0 = 8 + 5 * 8 + 4 + static_cast<std::size_t>(k);
+    t[o0] = static_cast<std::uint8_t>((static_cast<std::int8_t>(t[o0]) + 1 + in.run.n_outcomes) % in.run.n_outcomes);
     if (k % 2) t[t.size() - 1] ^= 1;  // and a flipped bit of the tag itself
     send_raw(bus, w::kTossBatch, t, &tampered);
   }

@@ -16,6 +16,12 @@ bin=$1 inject=$2 scenario=$3
 scene=scenes/paper/die1.toml
 seed=11
 n=20000
+# A scenario name ending in _d20 or _d4 runs the same scenario on that die (scenes/dice/):
+# everything that works for a d6 works for any number of outcomes.
+case "$scenario" in
+  *_d20) scene=scenes/dice/d20.toml; scenario=${scenario%_d20} ;;
+  *_d4) scene=scenes/dice/d4.toml; scenario=${scenario%_d4} ;;
+esac
 
 fail() { echo "FAIL [$scenario]: $*" >&2; for f in "$work"/*.err; do echo "--- $f" >&2; tail -n 20 "$f" >&2; done; exit 1; }
 # The JSON without the keys that legitimately differ between runs.
@@ -116,6 +122,14 @@ case "$scenario" in
     [ "$(health foreign "$work/agg.err")" -ge 3 ] || fail "foreign messages not counted"
     [ "$(health "out of range" "$work/agg.err")" -ge 3 ] || fail "out-of-range batches not counted"
     [ "$(health malformed "$work/agg.err")" -ge 20 ] || fail "malformed messages not counted"
+    ;;
+  run3)
+    # `dicesim run --workers 3` (its own worker processes) gives exactly `toss`'s counts.
+    reference
+    "$bin" run "$scene" --workers 3 --tosses "$n" --seed "$seed" --json > "$work/out.json" 2> "$work/run.err" ||
+      fail "dicesim run exited $?"
+    same_as_reference "$work/out.json"
+    grep -q '"threads":3' "$work/out.json" || fail "threads should report the 3 workers"
     ;;
   run_cmd)
     reference

@@ -18,6 +18,12 @@ bin=$1 scenario=$2
 scene=scenes/paper/die1.toml
 seed=13
 n=150000
+# A scenario name ending in _d20 or _d4 runs the same scenario on that die (scenes/dice/):
+# everything that works for a d6 works for any number of outcomes.
+case "$scenario" in
+  *_d20) scene=scenes/dice/d20.toml; scenario=${scenario%_d20} ;;
+  *_d4) scene=scenes/dice/d4.toml; scenario=${scenario%_d4} ;;
+esac
 
 fail() { echo "FAIL [$scenario]: $*" >&2; for f in "$work"/*.err; do echo "--- $f" >&2; tail -n 20 "$f" >&2; done; exit 1; }
 stable() { sed -E 's/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//; s/"tosses_per_s":[^,}]*,?//' "$1"; }
