@@ -76,9 +76,9 @@ FaceCounts read_counts(const std::string& path) {
         continue;
       }
       first = false;
-      if (!numeric || face < 1 || face > 99 || !(count >= 0) || count != std::floor(count) || count > 1e15)
+      if (!numeric || face < 0 || face > 999 || !(count >= 0) || count != std::floor(count) || count > 1e15)
         throw SceneError(path, "line " + std::to_string(line_no), "'" + l + "'",
-                         "expected face (an integer in [1, 99]) and count (an integer >= 0)");
+                         "expected face (a label, an integer in [0, 999]) and count (an integer >= 0)");
       fc.labels.push_back(static_cast<int>(face));
       fc.counts.push_back(static_cast<std::uint64_t>(count));
     }
@@ -119,7 +119,7 @@ int run_compare(const CompareArgs& a) {
   std::printf("\nchi-square homogeneity: %.2f on %d dof, p = %.3g -> %s at the %g level\n", c.chi2.statistic, c.chi2.dof,
               c.chi2.p_value, differ ? "DIFFERENT" : "not distinguishable", a.alpha);
   if (c.min_expected < 5.0) std::printf("note: an expected count is %.2f (< 5): the chi-square p-value is rough\n", c.min_expected);
-  std::printf("* the face's interval excludes 0 (per face, not corrected for 6 comparisons)\n");
+  std::printf("* the face's interval excludes 0 (per face, not corrected for %zu comparisons)\n", c.faces.size());
   return kExitOk;
 }
 

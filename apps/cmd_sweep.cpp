@@ -66,7 +66,7 @@ SeedMatch match_seed(const SweepSpec& spec, const std::vector<ReferenceRow>& row
   if (spec.seed_tosses > 0) {
     const auto est = face_estimates(r.counts, r.labels);
     std::vector<std::uint64_t> ours, theirs;
-    for (std::size_t f = 0; f < 6; ++f) {
+    for (std::size_t f = 0; f < est.size() && f < 6; ++f) {  // run_sweep checked: labels 1..6
       ours.push_back(est[f].count);
       theirs.push_back(static_cast<std::uint64_t>(std::llround(row->p[f] * static_cast<double>(spec.seed_tosses))));
     }
@@ -103,8 +103,8 @@ std::string gnuplot_quote(const std::string& s) {
 
 bool has_categories(const SweepSpec& spec) { return spec.categorical; }
 
-// P(face) against x, one colour per face, the 95% Wilson band shaded, the seed's values (if any)
-// as open circles of the same colour.
+// P(face) against x, one colour per outcome (label order; ten colours, then again with another
+// point type), the 95% Wilson band shaded, the seed's values (if any) as open circles of the same colour.
 void write_plot(const std::string& path, const SweepSpec& spec, const SweepResult& res,
                 const std::vector<ReferenceRow>& seed_rows) {
   const std::string ext = fs::path(path).extension().string();
@@ -121,8 +121,15 @@ void write_plot(const std::string& path, const SweepSpec& spec, const SweepResul
      << " noenhanced\n";
   gp << "set xlabel " << gnuplot_quote(spec.x_label) << " noenhanced\n";
   gp << "set offsets 0, 0, graph 0.04, graph 0.04\nset ylabel 'P(face up)'\nset grid\nset key outside right top box opaque\nset border 3\nset tics nomirror\n";
-  const char* colours[6] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#17becf"};
-  for (int f = 0; f < 6; ++f) gp << "set linetype " << f + 1 << " lc rgb '" << colours[f] << "' lw 2 pt 7 ps 0.6\n";
+  const auto labels = res.points.empty() ? std::vector<FaceEstimate>{} : face_estimates(res.points[0].counts, res.points[0].labels);
+  const int n = static_cast<int>(labels.size());
+  const char* colours[10] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
+                             "#17becf", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22"};
+  const int point_types[4] = {7, 5, 9, 13};
+  for (int f = 0; f < n; ++f)
+    gp << "set linetype " << f + 1 << " lc rgb '" << colours[f % 10] << "' lw 2 pt " << point_types[(f / 10) % 4]
+       << " ps 0.6\n";
+  if (n > 12) gp << "set key font ',8' spacing 0.8\n";
   if (has_categories(spec)) {
     gp << "set xtics (";
     for (std::size_t i = 0; i < spec.points.size(); ++i)
@@ -150,14 +157,13 @@ void write_plot(const std::string& path, const SweepSpec& spec, const SweepResul
       gp << "\n";
     }
   gp << "EOD\n";
-  const auto labels = res.points.empty() ? std::array<FaceEstimate, 6>{} : face_estimates(res.points[0].counts, res.points[0].labels);
   gp << "plot ";
-  for (int f = 1; f <= 6; ++f)
+  for (int f = 1; f <= n; ++f)
     gp << "$d using 1:" << 3 * f << ":" << 3 * f + 1 << " with filledcurves lt " << f
        << " fs transparent solid 0.18 noborder notitle, ";
-  for (int f = 1; f <= 6; ++f)
+  for (int f = 1; f <= n; ++f)
     gp << "$d using 1:" << 3 * f - 1 << " with linespoints lt " << f << " title 'face "
-       << labels[static_cast<std::size_t>(f - 1)].label << "'" << (f < 6 || any_seed ? ", " : "\n");
+       << labels[static_cast<std::size_t>(f - 1)].label << "'" << (f < n || any_seed ? ", " : "\n");
   if (any_seed) {
     for (int f = 1; f <= 6; ++f) gp << "$s using 1:" << f + 1 << " with points lt " << f << " pt 6 ps 1.1 notitle, ";
     gp << "NaN with points pt 6 ps 1.1 lc rgb 'black' title 'seed'\n";
@@ -249,7 +255,7 @@ std::string table_text(const SweepSpec& spec, const SweepResult& res, int thread
       << ", seed " << spec.seed << ", " << spec.tosses << " tosses per point, ";
   if (workers > 0) out << workers << " worker process" << (workers == 1 ? "" : "es") << ")\n\n";
   else out << threads << " thread" << (threads == 1 ? "" : "s") << ")\n\n";
-  const auto first = res.points.empty() ? std::array<FaceEstimate, 6>{} : face_estimates(res.points[0].counts, res.points[0].labels);
+  const auto first = res.points.empty() ? std::vector<FaceEstimate>{} : face_estimates(res.points[0].counts, res.points[0].labels);
   char line[512];
   std::snprintf(line, sizeof line, "%-14s", spec.x_label.size() <= 14 ? spec.x_label.c_str() : "x");
   out << line;
@@ -279,28 +285,31 @@ std::string table_text(const SweepSpec& spec, const SweepResult& res, int thread
 // homogeneity of the two runs' counts (the seed's counts taken as p x its tosses per point).
 std::string markdown_text(const SweepSpec& spec, const SweepResult& res, const std::vector<ReferenceRow>& seed_rows) {
   std::ostringstream md;
-  const bool have_seed = !seed_rows.empty();
+  const bool have_seed = !seed_rows.empty();  // run_sweep checked: then the labels are 1..6
+  const std::vector<int> labels = res.points.empty() ? std::vector<int>{} : res.points[0].labels;
+  const std::size_t n = labels.size();
   md << "| " << spec.x_label << " |";
-  for (int f = 1; f <= 6; ++f) md << " P(" << f << ") |";
+  for (int l : labels) md << " P(" << l << ") |";
   if (have_seed && spec.seed_tosses > 0) md << " χ² p vs seed |";
   md << "\n|---|";
-  for (int f = 1; f <= 6; ++f) md << "---|";
+  for (std::size_t f = 0; f < n; ++f) md << "---|";
   if (have_seed && spec.seed_tosses > 0) md << "---|";
   md << "\n";
   int compared = 0, rejected = 0;
-  std::array<double, 6> sum_ours{}, sum_seed{};
+  std::vector<double> sum_ours(n, 0.0), sum_seed(n, 0.0);
   int n_seed = 0;
   double worst = 0.0;
   for (const SweepPointResult& r : res.points) {
     const SeedMatch m = match_seed(spec, seed_rows, r);
     md << "| " << r.point.label << " |";
     const auto est = face_estimates(r.counts, r.labels);
-    for (std::size_t f = 0; f < 6; ++f) {
+    for (std::size_t f = 0; f < n && f < est.size(); ++f) {
+      const bool seed_has = m.found && f < m.p.size();
       md << " " << fmt("%.4f", est[f].p);
-      if (m.found) md << " (" << fmt("%.4f", m.p[f]) << ")";
+      if (seed_has) md << " (" << fmt("%.4f", m.p[f]) << ")";
       md << " |";
       worst = std::max(worst, est[f].ci95.half_width());
-      if (m.found) {
+      if (seed_has) {
         sum_ours[f] += est[f].p;
         sum_seed[f] += m.p[f];
       }
@@ -322,12 +331,12 @@ std::string markdown_text(const SweepSpec& spec, const SweepResult& res, const s
      << ", the same toss indices at every point); widest 95% Wilson half-width " << fmt("%.4f", worst) << ".";
   if (n_seed > 0) {
     md << " Mean over the " << n_seed << " matched points, ours (seed):";
-    for (std::size_t f = 0; f < 6; ++f)
-      md << " P(" << f + 1 << ") " << fmt("%.4f", sum_ours[f] / n_seed) << " (" << fmt("%.4f", sum_seed[f] / n_seed) << ")"
-         << (f < 5 ? "," : ".");
+    for (std::size_t f = 0; f < n; ++f)
+      md << " P(" << labels[f] << ") " << fmt("%.4f", sum_ours[f] / n_seed) << " (" << fmt("%.4f", sum_seed[f] / n_seed) << ")"
+         << (f + 1 < n ? "," : ".");
   }
   if (compared > 0)
-    md << " χ² homogeneity (5 dof; the seed's counts taken as p × " << spec.seed_tosses << "): " << rejected << " of "
+    md << " χ² homogeneity (" << n - 1 << " dof; the seed's counts taken as p × " << spec.seed_tosses << "): " << rejected << " of "
        << compared << " points differ at the 1% level (✗).";
   md << "\n";
   return md.str();

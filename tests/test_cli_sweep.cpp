@@ -201,8 +201,76 @@ TEST(CliCompare, BadInput) {
   expect_bad_input(cli("compare data/seed-experiments/die1_counts.csv " + bad), {"bad_counts.csv", "line 3", "count"});
   const std::string five = tmp("five_faces.csv");
   std::ofstream(five) << "1,10\n2,10\n3,10\n4,10\n5,10\n7,10\n";
-  expect_bad_input(cli("compare data/seed-experiments/die1_counts.csv " + five), {"different face labels"});
+  expect_bad_input(cli("compare data/seed-experiments/die1_counts.csv " + five),
+                   {"different face labels", "missing in A: 7", "missing in B: 6"});
   expect_bad_input(cli("compare nope.json data/seed-experiments/die1_counts.csv"), {"nope.json", "cannot open"});
+}
+
+// Any die: a d20's run against observed counts with labels 0..999 (any integers), in label order
+// with N - 1 degrees of freedom; and a sweep of a d20 reports its 20 outcomes at every point.
+TEST(CliCompare, AnyLabelsInLabelOrderWithNMinusOneDof) {
+  const std::string sim = tmp("d20.json");
+  ASSERT_EQ(cli("toss scenes/dice/d20.toml -n 3000 --json > " + sim).code, 0);
+  const std::string obs = tmp("d20_counts.csv");
+  {
+    std::ofstream out(obs);
+    out << "face,count\n";
+    for (int f = 20; f >= 1; --f) out << f << "," << 140 + f << "\n";  // any order in the file
+  }
+  const CliRun r = cli("compare " + sim + " " + obs + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["chi2"]["dof"], 19);
+  ASSERT_EQ(j["faces"].size(), 20u);
+  for (int f = 0; f < 20; ++f) {
+    EXPECT_EQ(j["faces"][f]["face"], f + 1);
+    EXPECT_EQ(j["faces"][f]["count_b"], 141 + f);
+  }
+  const CliRun table = cli("compare " + sim + " " + obs);
+  EXPECT_NE(table.out.find("not corrected for 20 comparisons"), std::string::npos) << table.out;
+  // Labels 0 and 999 are labels like any other; a d6's counts against a d20 name what is missing.
+  const std::string wide = tmp("wide_labels.csv");
+  std::ofstream(wide) << "0,10\n500,12\n999,9\n";
+  const CliRun self = cli("compare " + wide + " " + wide + " --json");
+  ASSERT_EQ(self.code, 0) << self.err;
+  EXPECT_EQ(nlohmann::json::parse(self.out)["faces"][2]["face"], 999);
+  expect_bad_input(cli("compare " + sim + " data/seed-experiments/die1_counts.csv"),
+                   {"missing in B: 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20", "missing in A: none"});
+  const std::string big = tmp("big_label.csv");
+  std::ofstream(big) << "1,10\n1000,10\n";
+  expect_bad_input(cli("compare " + wide + " " + big), {"big_label.csv", "line 2", "[0, 999]"});
+}
+
+TEST(CliSweep, AD20SweepReportsEveryOutcomeInLabelOrder) {
+  const CliRun r = cli("sweep scenes/dice/d20.toml --param floor.restitution --values 0.3,0.8 -n 1000 --seed 2 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["points"].size(), 2u);
+  for (const auto& p : j["points"]) {
+    ASSERT_EQ(p["faces"].size(), 20u);
+    int sum = 0;
+    for (int f = 0; f < 20; ++f) {
+      EXPECT_EQ(p["faces"][f]["face"], f + 1);
+      sum += p["faces"][f]["count"].get<int>();
+    }
+    EXPECT_EQ(sum, p["settled"].get<int>());
+  }
+  // The same points tossed one by one: identical counts (the sweep adds nothing of its own).
+  const CliRun one = cli("toss scenes/dice/d20.toml --set floor.restitution=0.8 -n 1000 --seed 2 --json");
+  ASSERT_EQ(one.code, 0) << one.err;
+  const auto t = nlohmann::json::parse(one.out);
+  for (int f = 0; f < 20; ++f) EXPECT_EQ(j["points"][1]["faces"][f]["count"], t["faces"][f]["count"]);
+  EXPECT_EQ(t["chi2_uniform"]["dof"], 19);
+  const std::string md = tmp("d20.md");
+  const CliRun m = cli("sweep scenes/dice/d20.toml --param floor.restitution --values 0.3 -n 200 --markdown " + md);
+  ASSERT_EQ(m.code, 0) << m.err;
+  std::ifstream in(md);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_NE(header.find("P(1) |"), std::string::npos) << header;
+  EXPECT_NE(header.find("P(20) |"), std::string::npos) << header;
+  // Points whose dice differ in outcomes cannot share a table: bad input naming the point.
+  expect_bad_input(cli("sweep scenes/dice/prism3.toml --param die.sides --values 3,4 -n 100"), {"die.sides", "same outcome labels"});
 }
 
 }  // namespace

@@ -2,9 +2,6 @@
 // from below such as a d4, most nearly down), and the outcome (label) it shows.
 #pragma once
 
-#include <array>
-#include <stdexcept>
-
 #include "sim/body/die_model.hpp"
 
 namespace dicesim {
@@ -24,14 +21,6 @@ inline int read_face_index(const DieModel& m, const Mat3& R) {
     }
   }
   return best;
-}
-
-// The model's outcome labels when it has exactly six (the LCM wire carries six until it carries N).
-inline std::array<int, 6> six_outcome_labels(const DieModel& m) {
-  if (m.outcomes() != 6) throw std::invalid_argument("the die does not have six outcomes");
-  std::array<int, 6> out{};
-  for (std::size_t i = 0; i < 6; ++i) out[i] = m.outcome_labels[i];
-  return out;
 }
 
 }  // namespace dicesim

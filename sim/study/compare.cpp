@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <string>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
@@ -59,8 +61,21 @@ Comparison compare_counts(const FaceCounts& a, const FaceCounts& b) {
   std::vector<int> la = a.labels, lb = b.labels;
   std::sort(la.begin(), la.end());
   std::sort(lb.begin(), lb.end());
-  if (la != lb) throw std::invalid_argument("compare: the two results have different face labels");
-  if (std::adjacent_find(la.begin(), la.end()) != la.end()) throw std::invalid_argument("compare: a face label repeats");
+  if (std::adjacent_find(la.begin(), la.end()) != la.end() || std::adjacent_find(lb.begin(), lb.end()) != lb.end())
+    throw std::invalid_argument("compare: a face label repeats");
+  if (la != lb) {
+    // Say which: labels of one result that the other lacks (e.g. a d20 against a d6's counts).
+    auto list = [](const std::vector<int>& v) {
+      std::string s;
+      for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + std::to_string(v[i]);
+      return s.empty() ? std::string("none") : s;
+    };
+    std::vector<int> only_a, only_b;
+    std::set_difference(la.begin(), la.end(), lb.begin(), lb.end(), std::back_inserter(only_a));
+    std::set_difference(lb.begin(), lb.end(), la.begin(), la.end(), std::back_inserter(only_b));
+    throw std::invalid_argument("compare: the two results have different face labels: missing in A: " + list(only_b) +
+                                "; missing in B: " + list(only_a));
+  }
 
   Comparison c;
   c.n_a = a.total();

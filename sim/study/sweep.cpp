@@ -340,10 +340,20 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
     std::vector<std::string> all = spec.overrides;
     all.insert(all.end(), p.overrides.begin(), p.overrides.end());
     models.push_back(compile(load_scene(spec.scene, all), spec.scene));
-    if (models.back().outcomes() != 6)
-      throw SceneError(spec.scene, "die.shape", models.back().kind,
-                       "sweeps need a die with six outcomes for now (this one has " +
-                           std::to_string(models.back().outcomes()) + "); use `dicesim toss` per value");
+    // One table: the same outcomes at every point (a sweep of die.sides is a sweep per die).
+    const std::vector<int>& labels = models.back().outcome_labels;
+    auto text = [](const std::vector<int>& v) {
+      std::string s;
+      for (std::size_t i = 0; i < v.size(); ++i) s += (i ? "," : "") + std::to_string(v[i]);
+      return s;
+    };
+    if (labels != models.front().outcome_labels)
+      throw SceneError(spec.source.empty() ? spec.scene : spec.source, "point " + spec.x_label + " = " + p.label, text(labels),
+                       "every point of a sweep must have the same outcome labels as the first (" +
+                           text(models.front().outcome_labels) + ")");
+    if (!spec.seed_table.empty() && labels != std::vector<int>{1, 2, 3, 4, 5, 6})
+      throw SceneError(spec.source.empty() ? spec.scene : spec.source, "seed_table", spec.seed_table,
+                       "compares P1..P6: the die must have six outcomes labelled 1..6 (this one: " + text(labels) + ")");
     overrides.push_back(std::move(all));
   }
   SweepResult out;
@@ -372,7 +382,7 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
       r.counts = run_tosses(models[i], cfg);
     }
     if (opt.cancel && opt.cancel->load()) break;  // a cancelled point is incomplete: not reported
-    r.labels = six_outcome_labels(models[i]);
+    r.labels = models[i].outcome_labels;
     r.fidelity = to_string(models[i].fidelity);
     out.points.push_back(std::move(r));
     if (opt.progress) opt.progress(before + spec.tosses, total);
@@ -381,10 +391,10 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
   return out;
 }
 
-std::array<FaceEstimate, 6> face_estimates(const RunCounts& counts, const std::array<int, 6>& labels) {
-  std::array<FaceEstimate, 6> f{};
-  for (std::size_t i = 0; i < 6; ++i) {
-    const std::uint64_t c = counts.faces[i];
+std::vector<FaceEstimate> face_estimates(const RunCounts& counts, const std::vector<int>& labels) {
+  std::vector<FaceEstimate> f(labels.size());
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    const std::uint64_t c = i < counts.faces.size() ? counts.faces[i] : 0;
     f[i].label = labels[i];
     f[i].count = c;
     f[i].p = counts.settled ? static_cast<double>(c) / static_cast<double>(counts.settled) : 0.0;

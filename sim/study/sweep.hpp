@@ -86,7 +86,7 @@ SweepSpec load_sweep_file(const std::string& path);
 struct SweepPointResult {
   SweepPoint point;
   RunCounts counts;
-  std::array<int, 6> labels{};  // face label per face index
+  std::vector<int> labels;  // the model's outcome labels (counts.faces in this order)
   std::string fidelity;
 };
 
@@ -109,17 +109,19 @@ struct SweepRunOptions {
 };
 
 // Loads and compiles every point first (bad input fails before any toss), then tosses each with
-// run_tosses over the same seed and indices 0..tosses-1.
+// run_tosses over the same seed and indices 0..tosses-1. Every point's die must have the same
+// outcome labels (any number of them), and a seed table (P1..P6) needs six labelled 1..6: else
+// SceneError naming the point.
 SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt);
 
-// Per-face values of a point, by label 1..6 order (labels sorted ascending).
+// Per-outcome values of a point, in label order (ascending), one per outcome of the die.
 struct FaceEstimate {
   int label = 0;
   std::uint64_t count = 0;
   double p = 0.0;
   Interval ci95;
 };
-std::array<FaceEstimate, 6> face_estimates(const RunCounts& counts, const std::array<int, 6>& labels);
+std::vector<FaceEstimate> face_estimates(const RunCounts& counts, const std::vector<int>& labels);
 
 // A table of P(face) against x from a CSV such as the seed's tables: '#' comment lines, one
 // header line, then rows x,P1,...,P6 (faces 1..6). Throws SceneError naming the file and line.

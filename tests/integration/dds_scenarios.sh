@@ -19,6 +19,7 @@ case "$scenario" in
   *_d20) scene=scenes/dice/d20.toml; scenario=${scenario%_d20} ;;
   *_d4) scene=scenes/dice/d4.toml; scenario=${scenario%_d4} ;;
 esac
+echo "scenario $scenario on $scene"
 fail() {
   echo "FAIL [$scenario]: $*" >&2
   for f in "$work"/*.err "$work"/*.jsonl; do [ -f "$f" ] && { echo "--- $f" >&2; tail -n 15 "$f" >&2; }; done
