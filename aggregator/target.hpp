@@ -12,7 +12,7 @@ namespace dicesim::agg {
 
 inline constexpr std::uint64_t kTargetBlock = 10000;
 
-// Widest 95% Wilson half-width over the six faces (over settled tosses; 0.5 when none settled).
+// Widest 95% Wilson half-width over the die's outcomes (over settled tosses; 0.5 when none settled).
 double max_halfwidth(const RunCounts& c);
 inline bool halfwidth_reached(const RunCounts& c, double h) { return c.settled > 0 && max_halfwidth(c) <= h; }
 

@@ -36,7 +36,7 @@ struct RunCounts {
   RunCounts() = default;
   explicit RunCounts(int outcomes) : faces(static_cast<std::size_t>(outcomes), 0) {}
   // Settled tosses per outcome, in label order (the model's outcome_labels; several faces may
-  // share one). Six zeros by default, the wire's six outcomes; run_tosses sizes it to the model.
+  // share one). Six zeros by default (a d6); run_tosses and the aggregator size it to the model.
   std::vector<std::uint64_t> faces = std::vector<std::uint64_t>(6, 0);
   std::uint64_t settled = 0, unresolved = 0, invalid = 0;
   std::uint64_t bounces = 0;  // impacts over all tosses
