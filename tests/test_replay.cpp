@@ -356,3 +356,53 @@ TEST(ReplayCli, SameJsonAsTossAndExitCodes) {
   std::remove(cut.c_str());
   std::remove(log.path.c_str());
 }
+
+// A log of the six-outcome wire (recorded before the wire carried any number of outcomes): its
+// run_start has the old LCM type hash. Refused by name, exit 2, nothing on stdout.
+TEST(ReplayCli, ALogOfTheSixOutcomeWireIsRefusedByName) {
+  const std::string path = unique_temp("old.lcmlog");
+  {
+    el::EventLogWriter out(path);
+    // The old run_start's hash, then a body: never decoded, only recognised.
+    std::vector<std::uint8_t> old = {0x16, 0x85, 0x4f, 0xcd, 0x47, 0xc1, 0x6d, 0x6e};
+    old.resize(200, 0);
+    ASSERT_TRUE(out.write(1'700'000'000'000'000, w::kRunStart, old.data(), old.size()));
+  }
+  dicesim::testing::expect_bad_input(run_dicesim("replay " + path + " --json"),
+                                     {"recorded before runs carried any number of outcomes", "six-outcome wire", path.c_str()});
+  std::remove(path.c_str());
+}
+
+// A recorded d20 run replays to the live counts, 20 outcomes in label order (the log alone).
+TEST(ReplayCli, AD20LogReplaysToTossCounts) {
+  const std::string scene = "scenes/dice/d20.toml";
+  const std::string path = unique_temp("d20.lcmlog");
+  const dicesim::DieModel model = dicesim::compile(dicesim::load_scene(scene), scene);
+  const w::RunSpec spec = w::make_run_spec(77, scene, {}, model, 3, 3000);
+  {
+    el::EventLogWriter out(path);
+    std::int64_t utime = 1'700'000'000'000'000;
+    auto put = [&](const char* ch, const std::vector<std::uint8_t>& b) { ASSERT_TRUE(out.write(utime += 100, ch, b.data(), b.size())); };
+    put(w::kRunStart, w::encode(w::to_message(spec)));
+    for (std::uint64_t first = 0; first < 3000; first += 1000) {
+      dicesim_lcm::toss_batch b{};
+      b.run_id = 77, b.worker_id = 1, b.lease_id = 1, b.first_index = static_cast<std::int64_t>(first), b.count = 1000;
+      for (std::uint64_t i = first; i < first + 1000; ++i) {
+        const dicesim::TossResult r = dicesim::toss(model, 3, i);
+        b.outcomes.push_back(static_cast<std::int8_t>(r.status == dicesim::TossStatus::Settled ? r.outcome : -1));
+        b.statuses.push_back(static_cast<std::int8_t>(r.status));
+        b.bounces.push_back(r.bounces);
+      }
+      put(w::kTossBatch, w::encode(b));
+    }
+  }
+  const auto rep = run_dicesim("replay " + path + " --json");
+  ASSERT_EQ(rep.code, 0) << rep.err;
+  const auto ref = run_dicesim("toss " + scene + " --tosses 3000 --seed 3 --threads 1 --json");
+  ASSERT_EQ(ref.code, 0) << ref.err;
+  const auto a = nlohmann::json::parse(rep.out), b = nlohmann::json::parse(ref.out);
+  ASSERT_EQ(a["faces"].size(), 20u);
+  EXPECT_EQ(a["faces"], b["faces"]);
+  EXPECT_EQ(a["chi2_uniform"], b["chi2_uniform"]);
+  std::remove(path.c_str());
+}
