@@ -375,7 +375,7 @@ TEST(ReplayCli, ALogOfTheSixOutcomeWireIsRefusedByName) {
 
 // A recorded d20 run replays to the live counts, 20 outcomes in label order (the log alone).
 TEST(ReplayCli, AD20LogReplaysToTossCounts) {
-  const std::string scene = "scenes/dice/d20.toml";
+  const std::string scene = std::string(DICESIM_SOURCE_DIR) + "/scenes/dice/d20.toml";
   const std::string path = unique_temp("d20.lcmlog");
   const dicesim::DieModel model = dicesim::compile(dicesim::load_scene(scene), scene);
   const w::RunSpec spec = w::make_run_spec(77, scene, {}, model, 3, 3000);
