@@ -211,6 +211,9 @@ int forge(lcm::LCM& bus, Listener& in) {
   dicesim_lcm::run_start other = in.run;
   other.seed += 1;
   for (int k = 0; k < 5; ++k) {
+    // Spread over ~0.6 s: on a loaded machine a worker process may start a few hundred ms after
+    // the other, and each must hear (and drop) some of these.
+    if (k > 0) std::this_thread::sleep_for(std::chrono::milliseconds(150));
     send(bus, w::kProbabilities, fin, &to_workers);
     auto bytes = w::encode(fin);
     wrong.seal(w::kProbabilities, bytes);
