@@ -2,6 +2,8 @@
 // over the same in-memory bus as test_aggregator_run.cpp: forgeries are dropped and counted, a
 // run resumed from a checkpoint gives the counts of one thread.
 #include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -214,6 +216,22 @@ TEST(Checkpoint, JsonRoundTripKeepsEveryField) {
   EXPECT_THROW(agg::checkpoint_from_json(bad, "bad.ckpt"), agg::CheckpointError);
   EXPECT_THROW(agg::checkpoint_from_json("{\"format\":\"x\"}", "x.ckpt"), agg::CheckpointError);
   EXPECT_THROW(agg::checkpoint_from_json("not json", "y.ckpt"), agg::CheckpointError);
+  // Counts whose outcome count is not the run_start's die's: refused.
+  nlohmann::json j = nlohmann::json::parse(agg::to_json(c));
+  j["labels"].push_back(7);
+  EXPECT_THROW(agg::checkpoint_from_json(j.dump(), "labels.ckpt"), agg::CheckpointError);
+  // A checkpoint of the six-outcome wire (its run_start has the old type hash): refused by name.
+  j = nlohmann::json::parse(agg::to_json(c));
+  std::string hex = j["run_start"].get<std::string>();
+  hex.replace(0, 16, "16854fcd47c16d6e");
+  j["run_start"] = hex;
+  try {
+    agg::checkpoint_from_json(j.dump(), "old.ckpt");
+    FAIL() << "an old checkpoint was accepted";
+  } catch (const agg::CheckpointError& e) {
+    EXPECT_NE(std::string(e.what()).find("before runs carried any number of outcomes"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("old.ckpt"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Checkpoint, ResumedAggregatorGivesTheCountsOfOneThread) {
