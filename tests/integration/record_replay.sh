@@ -56,20 +56,26 @@ live_run() {
 
 case "$scenario" in
   record)
+    # The stock lcm-logger's format is checked on the d6 run only (the _d20 variant tests the die,
+    # not lcm-logger again, whose small queue loses datagrams of a fast run on a loaded machine).
+    stock=no
+    [ "$scene" = scenes/paper/die1.toml ] && stock=yes
     record rec -o "$work/run.lcmlog" --until-done --timeout 120
-    lcm-logger -q -f --lcm-url="$LCM_DEFAULT_URL&recv_buf_size=4194304" -c 'DICESIM_.*' "$work/stock.lcmlog" & logger=$!; pids+=($logger)
-    sleep 0.3
+    if [ $stock = yes ]; then
+      lcm-logger -q -f --lcm-url="$LCM_DEFAULT_URL&recv_buf_size=4194304" -c 'DICESIM_.*' "$work/stock.lcmlog" & logger=$!; pids+=($logger)
+      sleep 0.3
+    fi
     live_run 3 --trace-every 1000
     wait "$rec_pid" || fail "dicesim record --until-done exited $?"
-    sleep 0.3
-    kill -INT "$logger"; wait "$logger" || true
+    if [ $stock = yes ]; then sleep 0.3; kill -INT "$logger"; wait "$logger" || true; fi
     same_json "$work/live.json" "$work/ref.json" "live run vs toss"
 
     "$bin" replay "$work/run.lcmlog" --json > "$work/replay.json" 2> "$work/replay.err" || fail "replay exited $?"
     same_json "$work/replay.json" "$work/live.json" "replay of dicesim record's log"
     grep -q "identical to the live aggregator's final result" "$work/replay.err" || fail "no check against the recorded result"
-    code=0; "$bin" replay "$work/stock.lcmlog" --json > "$work/stock.json" 2> "$work/stock.err" || code=$?
-    if [ "$code" -eq 2 ] && grep -q "does not hold the whole run" "$work/stock.err"; then
+    code=0
+    [ $stock = yes ] && { "$bin" replay "$work/stock.lcmlog" --json > "$work/stock.json" 2> "$work/stock.err" || code=$?; }
+    if [ $stock = yes ] && [ "$code" -eq 2 ] && grep -q "does not hold the whole run" "$work/stock.err"; then
       # The stock lcm-logger keeps no large queue: on a loaded machine it can lose datagrams of a
       # full-speed run (the live aggregator re-leases what it lost; the logger cannot). Replay says
       # so (exit 2). Then record again, from our complete log played at a quarter of its pace.
@@ -82,7 +88,7 @@ case "$scenario" in
       code=0; "$bin" replay "$work/stock2.lcmlog" --json > "$work/stock.json" 2> "$work/stock.err" || code=$?
     fi
     [ "$code" -eq 0 ] || fail "replay of the stock lcm-logger's log exited $code"
-    same_json "$work/stock.json" "$work/live.json" "replay of the stock lcm-logger's log"
+    [ $stock = no ] || same_json "$work/stock.json" "$work/live.json" "replay of the stock lcm-logger's log"
 
     "$bin" replay "$work/run.lcmlog" --toss 2000 > "$work/toss.out" 2> "$work/toss.err" || fail "replay --toss 2000 exited $?"
     grep -q "agree" "$work/toss.out" || fail "replay --toss 2000 does not agree"
