@@ -386,18 +386,17 @@ NewtonResult polish_newton(const Body& b, const Points& pts, double pn[], Eigen:
     if (!accepted) {
       // No descent left: at the rounding floor if even the full step is below the tolerance.
       eval(false);
-      res.converged = body_change(dP) <= tol;
+      res.converged = body_change(dP) <= tol && body_change(Phi - P) <= tol;
       break;
     }
     eval(true);
-    if (body_change(trial) <= tol) {
+    if (body_change(trial) <= tol && body_change(Phi - P) <= tol) {
       res.converged = true;
       break;
     }
   }
   // End on the cones: P = Phi(P).
   const NewtonVec fix = Phi - P;
-  if (res.converged && body_change(fix) > tol) res.converged = false;
   if (res.converged) {
     apply(fix);
     P = Phi;
