@@ -361,6 +361,11 @@ NewtonResult polish_newton(const Body& b, const Points& pts, double pn[], Eigen:
     }
     ++res.iterations;
     J = NewtonMat::Identity(dim, dim) - dPhi;
+    if (fixed_radius)  // the normal impulses are not unknowns: their columns out, dP_n = 0
+      for (int i = 0; i < n; ++i) {
+        J.col(3 * i + 2).setZero();
+        J(3 * i + 2, 3 * i + 2) = 1.0;
+      }
     cod.compute(J);
     dP = -cod.solve(F);
     // Backtracking on |F|^2 (the step from a kink can overshoot, and a step in the null space of
@@ -557,7 +562,8 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
   bool solved = false;
   if (c.n == 1) {
     solved = solve_plastic_single(b, pts, pn, pt);
-    if (!solved) ++res.corrections.fallbacks;  // a jam: no sliding direction stops the point
+    // A jam (no sliding direction found that stops the point): the general solve below takes it
+    // (Gauss-Seidel, finished by Newton), counted only if that does not converge.
   }
   if (!solved) {
     for (int i = 0; i < c.n; ++i) {
