@@ -35,6 +35,10 @@ struct Points {
   Eigen::Matrix2d wtt[kMaxContacts];         // tangential 2x2 block of W
   Eigen::Matrix2d inv_wtt[kMaxContacts];     // its inverse
   Mat3 W0;                                   // full compliance of point 0 (single-contact law)
+  // The body's response to a unit impulse at point i along x, y, z: angular velocity
+  // I_w^-1 (r x e_k), and the point's own velocity change along z (W's third column). The
+  // sweeps apply their impulses through these (no cross products or 3x3 products per update).
+  Vec3 ax[kMaxContacts], ay[kMaxContacts], az[kMaxContacts], wz[kMaxContacts];
 };
 
 struct Body {
@@ -428,16 +432,18 @@ SweepResult solve_plastic(const Body& b, const Points& pts, double pn[], Eigen::
                           double speed) {
   for (int it = 0; it < kMaxSweeps; ++it) {
     const SweepProbe probe(b);
+    Vec3& v = b.s->velocity;
+    Vec3& w = b.s->omega;
     for (int k = 0; k < pts.n; ++k) {
       const int i = it % 2 == 0 ? k : pts.n - 1 - k;
-      const Vec3& r = pts.r[i];
-      Vec3 u = b.point_velocity(r);
+      Vec3 u = v + w.cross(pts.r[i]);
       const double new_n = std::max(0.0, pn[i] - u.z() * pts.inv_wnn[i]);
       const double dn = new_n - pn[i];
       if (dn != 0.0) {
         pn[i] = new_n;
-        b.apply(r, Vec3(0.0, 0.0, dn));
-        u = b.point_velocity(r);
+        v.z() += dn * b.inv_mass;
+        w += dn * pts.az[i];
+        u += dn * pts.wz[i];
       }
       // Tangential: the sticking update, or on the cone's edge opposite the slip (whose fixed
       // points are the same Coulomb law as the exact disc minimiser's, at a fraction of the cost).
@@ -454,7 +460,11 @@ SweepResult solve_plastic(const Body& b, const Points& pts, double pn[], Eigen::
       }
       const Eigen::Vector2d dt = t - pt[i];
       pt[i] = t;
-      if (dt.x() != 0.0 || dt.y() != 0.0) b.apply(r, Vec3(dt.x(), dt.y(), 0.0));
+      if (dt.x() != 0.0 || dt.y() != 0.0) {
+        v.x() += dt.x() * b.inv_mass;
+        v.y() += dt.y() * b.inv_mass;
+        w += dt.x() * pts.ax[i] + dt.y() * pts.ay[i];
+      }
     }
     if (probe.change(b, radius) <= kSweepTolerance * speed) return {it + 1, true};
   }
@@ -543,6 +553,11 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
     pts.inv_wnn[i] = 1.0 / W(2, 2);
     pts.wtt[i] = W.topLeftCorner<2, 2>();
     pts.inv_wtt[i] = pts.wtt[i].inverse();
+    const Vec3& r = pts.r[i];
+    pts.ax[i] = b.inv_inertia * Vec3(0.0, r.z(), -r.y());
+    pts.ay[i] = b.inv_inertia * Vec3(-r.z(), 0.0, r.x());
+    pts.az[i] = b.inv_inertia * Vec3(r.y(), -r.x(), 0.0);
+    pts.wz[i] = W.col(2);
     u0n[i] = b.point_velocity(pts.r[i]).z();
   }
   const auto energy = [&](const RigidState& x) {
