@@ -40,7 +40,7 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
                                 double t) const {
   // At t = 0 the step's own orientation, bit for bit as touching_corners saw it (so a corner left
   // out of the contact set is above the tolerance here too).
-  const Mat3 R = t == 0.0 ? rot_start_ : rot.orientation(t);
+  const Vec3 z_row = t == 0.0 ? Vec3(rot_start_.row(2).transpose()) : rot.bottom_row(t);
   const auto& verts = m_->vertices;
   const int nv = static_cast<int>(verts.size());
   double low = std::numeric_limits<double>::infinity();
@@ -50,7 +50,7 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
       ++j;
       continue;
     }
-    low = std::min(low, R.row(2).dot(verts[i]));
+    low = std::min(low, z_row.dot(verts[i]));
   }
   return p.z() + v.z() * t + low - m_->rounding;  // a rounded corner touches with its ball
 }
