@@ -288,8 +288,8 @@ struct NewtonResult {
   bool converged = false;
 };
 
-NewtonResult polish_newton(const Body& b, const Points& pts, double pn[], Eigen::Vector2d pt[], double radius,
-                           double speed, const double* fixed_radius = nullptr) {
+NewtonResult newton_attempt(const Body& b, const Points& pts, double pn[], Eigen::Vector2d pt[], double radius,
+                            double speed, const double* fixed_radius, double rho_scale) {
   NewtonResult res;
   const int n = pts.n, dim = 3 * n;
   if (n > kNewtonMaxPoints) return res;
@@ -301,7 +301,7 @@ NewtonResult polish_newton(const Body& b, const Points& pts, double pn[], Eigen:
       W.block<3, 3>(3 * i, 3 * j) = b.inv_mass * Mat3::Identity() - Xi * b.inv_inertia * Xj;
     }
   double rho[kNewtonMaxPoints];
-  for (int i = 0; i < n; ++i) rho[i] = 3.0 / W.block<3, 3>(3 * i, 3 * i).trace();
+  for (int i = 0; i < n; ++i) rho[i] = rho_scale * 3.0 / W.block<3, 3>(3 * i, 3 * i).trace();
   NewtonVec P(dim), F(dim), Phi(dim), u(dim);
   for (int i = 0; i < n; ++i) P.segment<3>(3 * i) = Vec3(pt[i].x(), pt[i].y(), fixed_radius ? 0.0 : pn[i]);
   NewtonMat J(dim, dim), dPhi(dim, dim);
@@ -419,6 +419,23 @@ NewtonResult polish_newton(const Body& b, const Points& pts, double pn[], Eigen:
     if (!fixed_radius) pn[i] = P(3 * i + 2);
   }
   return res;
+}
+
+// Newton with rho_i = 3 / tr W_ii, else (it can stall at a kink of Phi where F has a part outside
+// the range of the generalised Jacobian; which kink depends on rho) with rho / 8, then 8 rho, each
+// from the Gauss-Seidel iterate.
+NewtonResult polish_newton(const Body& b, const Points& pts, double pn[], Eigen::Vector2d pt[], double radius,
+                           double speed, const double* fixed_radius = nullptr) {
+  NewtonResult total;
+  for (const double scale : {1.0, 0.125, 8.0}) {
+    const NewtonResult r = newton_attempt(b, pts, pn, pt, radius, speed, fixed_radius, scale);
+    total.iterations += r.iterations;
+    if (r.converged) {
+      total.converged = true;
+      break;
+    }
+  }
+  return total;
 }
 
 // Projected Gauss-Seidel on the perfectly plastic frictional contact problem: at every point
