@@ -238,9 +238,10 @@ TEST(FrictionImpact, EnergyNeverRisesForOneToFourContacts) {
       }
   EXPECT_EQ(gained, 0) << "of " << impacts;
   EXPECT_EQ(clamps, 0) << "of " << impacts;
-  // Frictionless rescues (a multi-point solve with mu = 2 that did not converge left a point
-  // approaching): counted, and rare (measured: 165 of 28 800, mostly at mu = 2).
-  EXPECT_LE(fallbacks, impacts / 100) << "of " << impacts;
+  // Frictionless rescues (a multi-point solve that did not converge left a point approaching):
+  // 165 of 28 800 with Gauss-Seidel alone (mostly at mu = 2); none since the unconverged solves
+  // are finished by semismooth Newton.
+  EXPECT_EQ(fallbacks, 0) << "of " << impacts;
 }
 
 // One corner, sticking, e = 1: the old Chatterjee-Ruina branch gained energy here. Now the
@@ -287,8 +288,8 @@ TEST(FrictionImpact, CoulombAtEveryContactOfMultiPointImpacts) {
           const ImpactResult r = apply_friction_impact(m, l.s, l.c, restitution, nullptr, &P);
           ASSERT_EQ(P.n, k);
           ++solves;
-          // Gauss-Seidel may stop at its sweep cap where friction couples strongly into the
-          // normal direction (counted, reported; bounded below); Coulomb is asserted on the rest.
+          // A solve may end unconverged (counted, reported; bounded below): Coulomb is asserted
+          // on the rest.
           if (r.corrections.pgs_unconverged || r.corrections.fallbacks) {
             ++unconverged;
             continue;
@@ -311,8 +312,9 @@ TEST(FrictionImpact, CoulombAtEveryContactOfMultiPointImpacts) {
           }
           ++checked;
         }
-    // Measured (of 1800 solves each): mu 0.3 -> 38 (2.1%); mu 2 -> under 20%.
-    EXPECT_LE(unconverged, mu < 1.0 ? solves * 3 / 100 : solves / 5) << "mu " << mu;
+    // Measured (of 1800 solves each), Gauss-Seidel alone: mu 0.3 -> 38 (2.1%), mu 2 -> under 20%;
+    // with the Newton finish: 0, 0 and 3 (mu 2: faces whose Newton stalls at a kink).
+    EXPECT_LE(unconverged, mu < 1.0 ? 0 : solves / 200) << "mu " << mu;
   }
   EXPECT_GT(slipping, checked / 10);  // the sliding case is really exercised
 }

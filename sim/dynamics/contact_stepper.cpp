@@ -40,7 +40,7 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
                                 double t) const {
   // At t = 0 the step's own orientation, bit for bit as touching_corners saw it (so a corner left
   // out of the contact set is above the tolerance here too).
-  const Mat3 R = t == 0.0 ? rot_start_ : rot.orientation(t);
+  const Vec3 z_row = t == 0.0 ? Vec3(rot_start_.row(2).transpose()) : rot.bottom_row(t);
   const auto& verts = m_->vertices;
   const int nv = static_cast<int>(verts.size());
   double low = std::numeric_limits<double>::infinity();
@@ -50,12 +50,12 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
       ++j;
       continue;
     }
-    low = std::min(low, R.row(2).dot(verts[i]));
+    low = std::min(low, z_row.dot(verts[i]));
   }
   return p.z() + v.z() * t + low - m_->rounding;  // a rounded corner touches with its ball
 }
 
-void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, double* first_touch) {
+void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full) {
   const DieModel& m = *m_;
   // The impact (solved once per step in step(): it does not depend on d) is already in s0.
   a.s = s0;
@@ -72,30 +72,37 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   rot_start_ = s.R;
   const Vec3 p = s.position, v = s.velocity;
   a.G = lowest_new(c, p, v, rot, d);
-  if (first_touch && a.G < -touch_tol_) {
-    // Where this trajectory first touches (the first guess of the step length): f(lo) > 0 >= f(hi).
-    double lo = 0.0, hi = d, f_lo = lowest_new(c, p, v, rot, 0.0), f_hi = a.G;
-    int side = 0;
-    for (int it = 0; it < 100 && f_lo > touch_tol_ && hi - lo > 1e-15 * d; ++it) {
-      double mid = hi - f_hi * (hi - lo) / (f_hi - f_lo);
-      if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
-      const double f = lowest_new(c, p, v, rot, mid);
-      if (f > 0.0) {
-        lo = mid, f_lo = f;
-        if (side == -1) f_hi *= 0.5;
-        side = -1;
-      } else {
-        hi = mid, f_hi = f;
-        if (side == 1) f_lo *= 0.5;
-        side = 1;
-      }
-    }
-    *first_touch = lo > 0.0 ? lo : hi;
+  if (full) {
+    full_rot_ = rot;
+    full_p_ = p;
+    full_v_ = v;
   }
   s.position = p + d * v;
   Vec3 w;
   rot.state(d, s.R, w);
   s.omega = w;
+}
+
+double FixedStepper::model_root(const ContactSet& c, double miss, double lo, double hi) const {
+  double f_lo = corrected_G(c, miss, lo), f_hi = corrected_G(c, miss, hi);
+  int side = 0;
+  double mid = hi;
+  for (int it = 0; it < 100 && hi - lo > 1e-15 * h_; ++it) {
+    mid = hi - f_hi * (hi - lo) / (f_hi - f_lo);
+    if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
+    const double f = corrected_G(c, miss, mid);
+    if (std::abs(f) <= 1e-3 * touch_tol_) break;
+    if (f > 0.0) {
+      lo = mid, f_lo = f;
+      if (side == -1) f_hi *= 0.5;
+      side = -1;
+    } else {
+      hi = mid, f_hi = f;
+      if (side == 1) f_lo *= 0.5;
+      side = 1;
+    }
+  }
+  return mid;
 }
 
 // Trials of the shortened step's length (each a whole step) before taking the best one.
@@ -119,17 +126,18 @@ int FixedStepper::step(RigidState& s) {
     impact_ = un < -(v_impact_ + v_spin_ * s0.omega.squaredNorm());
     if (impact_) imp_ = apply_friction_impact(m, s0, c, /*restitution=*/true);
   }
-  double first = h_;
-  try_step(s0, c, h_, a_, &first);
+  try_step(s0, c, h_, a_, /*full=*/true);
   const Attempt* done = &a_;
   double dt = h_;
   if (a_.G < -touch_tol_) {
     // A corner not yet touching would end the step below the floor. The step is shortened to the
     // instant it touches: the length d whose whole step (gravity's kick g d, the contact solve,
     // the free motion) ends with that corner on the floor, G(d) = 0 (G: the lowest such corner's
-    // height at the step's end). Illinois on G from the bracket [0, h], first guess the touch
-    // of the full step's own trajectory. Each trial is a whole step, so the accepted one keeps
-    // every property of a step (energy included).
+    // height at the step's end). Each trial is a whole step, so the accepted one keeps every
+    // property of a step (energy included). The trials' lengths: the root of the full step's model
+    // of G (model_G: exact without contact, so one trial), then of the model corrected by the last
+    // trial's miss (defect correction, while the model stays bracketing), then Illinois on G
+    // itself in the bracket the trials have found.
     const Vec3 z_row = s0.R.row(2).transpose();
     double g_lo = std::numeric_limits<double>::infinity();
     {
@@ -143,25 +151,43 @@ int FixedStepper::step(RigidState& s) {
       }
     }
     double d_lo = 0.0, d_hi = h_, g_hi = a_.G;
-    double d = first > 0.0 && first < h_ ? first : 0.5 * h_;
+    bool modelled = model_G(c, 0.0) > 0.0;
+    double d = modelled ? model_root(c, 0.0, 0.0, h_) : 0.5 * h_;
     bool have_lo = false;
     int side = 0;
     done = nullptr;
     for (int k = 0; k < kMaxTrials; ++k) {
-      try_step(s0, c, d, b_, nullptr);
+      try_step(s0, c, d, b_);
       if (std::abs(b_.G) <= touch_tol_) {
         done = &b_;
         dt = d;
         break;
       }
-      if (b_.G > 0.0) {
+      const double span = d * (h_ - d);
+      const double miss = span > 0.0 ? (b_.G - model_G(c, d)) / span : 0.0;
+      const bool above = b_.G > 0.0;
+      if (above) {
         d_lo = d, g_lo = b_.G;
         std::swap(b_, lo_);
         have_lo = true;
+      } else {
+        d_hi = d, g_hi = b_.G;
+      }
+      // Defect correction (twice at most) while the corrected model brackets a root in [d_lo, d_hi].
+      modelled = modelled && k < 2 && corrected_G(c, miss, d_lo) > 0.0 && corrected_G(c, miss, d_hi) <= 0.0;
+      if (modelled) {
+        const double next = model_root(c, miss, d_lo, d_hi);
+        if (next > d_lo && next < d_hi) {
+          d = next;
+          continue;
+        }
+        modelled = false;
+      }
+      // Illinois on G itself (regula falsi halving the stale end's weight).
+      if (above) {
         if (side == -1) g_hi *= 0.5;
         side = -1;
       } else {
-        d_hi = d, g_hi = b_.G;
         if (side == 1) g_lo *= 0.5;
         side = 1;
       }
@@ -175,7 +201,7 @@ int FixedStepper::step(RigidState& s) {
         done = &lo_;
         dt = d_lo;
       } else {  // every trial ended below: the shortest, its corner within rounding of the floor
-        try_step(s0, c, d_hi, b_, nullptr);
+        try_step(s0, c, d_hi, b_);
         done = &b_;
         dt = d_hi;
       }

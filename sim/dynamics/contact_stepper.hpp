@@ -58,8 +58,8 @@ class FixedStepper {
   double max_energy_gain = 0.0;   // largest relative gain of one impact's kinetic or one step's mechanical energy
 
  private:
-  // One trial step of length d from s0 with contact set c; first_touch (optional): where its
-  // free motion first brings a corner not in c to the floor, when it does within d.
+  // One trial step of length d from s0 with contact set c; full: the step of length h, whose
+  // free motion is kept (full_*) as the model of the shortened steps.
   struct Attempt {
     RigidState s;
     bool impact = false;
@@ -67,7 +67,18 @@ class FixedStepper {
     ContactImpulses next;
     double G = 0.0;  // lowest height at the step's end over corners not in c
   };
-  void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, double* first_touch);
+  void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
+  // The model of G(d) from the full step's free motion: its lowest new corner at t, raised by what
+  // the smaller gravity kick of a step of length t changes, g (h - t) t. Exact for a step without
+  // contact (the rotation is the same); with contact the solve absorbs part of the kick.
+  double model_G(const ContactSet& c, double t) const {
+    return lowest_new(c, full_p_, full_v_, full_rot_, t) + m_->gravity * (h_ - t) * t;
+  }
+  // The model corrected by a trial's miss: model_G(t) + miss t (h - t) (the model is exact at
+  // t = 0, the step's start, and at t = h, the full step itself).
+  double corrected_G(const ContactSet& c, double miss, double t) const { return model_G(c, t) + miss * t * (h_ - t); }
+  // The root of corrected_G in [lo, hi] (> 0 at lo, <= 0 at hi), Illinois.
+  double model_root(const ContactSet& c, double miss, double lo, double hi) const;
   // The lowest height over corners not in c, at time t of the free motion after the step's solve.
   double lowest_new(const ContactSet& c, const Vec3& p, const Vec3& v, const TorqueFreeRotation& rot, double t) const;
   const DieModel* m_;
@@ -77,6 +88,8 @@ class FixedStepper {
   Mat3 rot_start_ = Mat3::Identity();  // orientation at the start of the step being tried
   Attempt a_, b_, lo_;                  // trial steps (members: ContactImpulses is large)
   ContactImpulses warm_;  // the last plastic solve's impulses (warm start of the next)
+  TorqueFreeRotation full_rot_;  // the full step's free motion (model_G)
+  Vec3 full_p_ = Vec3::Zero(), full_v_ = Vec3::Zero();
   bool impact_ = false;   // the current step starts with an impact (solved once for all its trials)
   ImpactResult imp_;      // that impact's result
 };

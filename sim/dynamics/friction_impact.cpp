@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/QR>
+
 #include "sim/dynamics/contact.hpp"
 
 namespace dicesim {
@@ -33,6 +35,10 @@ struct Points {
   Eigen::Matrix2d wtt[kMaxContacts];         // tangential 2x2 block of W
   Eigen::Matrix2d inv_wtt[kMaxContacts];     // its inverse
   Mat3 W0;                                   // full compliance of point 0 (single-contact law)
+  // The body's response to a unit impulse at point i along x, y, z: angular velocity
+  // I_w^-1 (r x e_k), and the point's own velocity change along z (W's third column). The
+  // sweeps apply their impulses through these (no cross products or 3x3 products per update).
+  Vec3 ax[kMaxContacts], ay[kMaxContacts], az[kMaxContacts], wz[kMaxContacts];
 };
 
 struct Body {
@@ -261,6 +267,177 @@ struct SweepResult {
   bool converged = true;
 };
 
+// Semismooth Newton on the Alart-Curnier equations of the same plastic frictional problem, for
+// the solves Gauss-Seidel leaves unconverged. Those are edges (two corners) near the stick-slip
+// boundary: the compliance of two corners has rank 5 (equal and opposite friction along the edge
+// moves nothing), so Gauss-Seidel's error decays by only ~1-4% per sweep there. Newton on
+// F(P) = P - Phi(P), Phi_n = max(0, P_n - rho u_n), Phi_t = the projection of P_t - rho u_t on
+// the disc of radius mu Phi_n (F = 0 is exactly Coulomb's law with maximal dissipation, any
+// rho > 0), converges quadratically from the Gauss-Seidel iterate; its linear systems are solved
+// in the least-squares, minimum-norm sense (complete orthogonal decomposition), which copes with
+// the rank deficiency. Starts from (pn, pt) as applied to the body; ends with P = Phi(P), so every
+// impulse is exactly in its cone. Converged when that last correction and the last Newton step
+// each move the body's velocity by less than the sweeps' tolerance.
+constexpr int kNewtonMaxPoints = 8;
+constexpr int kNewtonMaxIterations = 40;
+using NewtonMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3 * kNewtonMaxPoints, 3 * kNewtonMaxPoints>;
+using NewtonVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3 * kNewtonMaxPoints, 1>;
+
+struct NewtonResult {
+  int iterations = 0;
+  bool converged = false;
+};
+
+NewtonResult newton_attempt(const Body& b, const Points& pts, double pn[], Eigen::Vector2d pt[], double radius,
+                            double speed, const double* fixed_radius, double rho_scale) {
+  NewtonResult res;
+  const int n = pts.n, dim = 3 * n;
+  if (n > kNewtonMaxPoints) return res;
+  // Delassus matrix W (u = u0 + W P), world axes per point: x, y tangential, z normal.
+  NewtonMat W(dim, dim);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const Mat3 Xi = skew(pts.r[i]), Xj = skew(pts.r[j]);
+      W.block<3, 3>(3 * i, 3 * j) = b.inv_mass * Mat3::Identity() - Xi * b.inv_inertia * Xj;
+    }
+  double rho[kNewtonMaxPoints];
+  for (int i = 0; i < n; ++i) rho[i] = rho_scale * 3.0 / W.block<3, 3>(3 * i, 3 * i).trace();
+  NewtonVec P(dim), F(dim), Phi(dim), u(dim);
+  for (int i = 0; i < n; ++i) P.segment<3>(3 * i) = Vec3(pt[i].x(), pt[i].y(), fixed_radius ? 0.0 : pn[i]);
+  NewtonMat J(dim, dim), dPhi(dim, dim);
+  // Phi(P) and, optionally, its generalised Jacobian, at the body's current velocities.
+  const auto eval = [&](bool jacobian) {
+    for (int i = 0; i < n; ++i) u.segment<3>(3 * i) = b.point_velocity(pts.r[i]);
+    if (jacobian) dPhi.setZero();
+    for (int i = 0; i < n; ++i) {
+      const int k = 3 * i;
+      // With fixed radii (the restitution phase's friction) the normal impulses are not unknowns:
+      // Phi_n = P_n (= 0), F_n = 0.
+      const double xn = fixed_radius ? 0.0 : P(k + 2) - rho[i] * u(k + 2);
+      const double phin = fixed_radius ? P(k + 2) : std::max(0.0, xn);
+      const Eigen::Vector2d xt(P(k) - rho[i] * u(k), P(k + 1) - rho[i] * u(k + 1));
+      const double R = fixed_radius ? fixed_radius[i] : pts.mu[i] * phin, xtn = xt.norm();
+      const bool inside = xtn <= R;
+      const Eigen::Vector2d phit = inside ? xt : (xtn > 0.0 ? Eigen::Vector2d(xt * (R / xtn)) : Eigen::Vector2d::Zero());
+      Phi.segment<3>(k) = Vec3(phit.x(), phit.y(), phin);
+      if (!jacobian) continue;
+      // d(xi)/dP = E - rho W (rows of point i).
+      Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3 * kNewtonMaxPoints> dxi = -rho[i] * W.middleRows<3>(k);
+      dxi.block<3, 3>(0, k) += Mat3::Identity();
+      if (fixed_radius) {
+        dPhi(k + 2, k + 2) = 1.0;
+      } else if (xn > 0.0) {
+        dPhi.row(k + 2) = dxi.row(2);
+      }
+      if (inside) {
+        dPhi.middleRows<2>(k) = dxi.topRows<2>();
+      } else if (xtn > 0.0) {
+        const Eigen::Vector2d h = xt / xtn;
+        const Eigen::Matrix2d Pp = (R / xtn) * (Eigen::Matrix2d::Identity() - h * h.transpose());
+        dPhi.middleRows<2>(k) = Pp * dxi.topRows<2>();
+        if (xn > 0.0) dPhi.middleRows<2>(k) += pts.mu[i] * h * dxi.row(2);
+      }
+    }
+    F = P - Phi;
+  };
+  const auto apply = [&](const NewtonVec& dP) {
+    for (int i = 0; i < n; ++i) b.apply(pts.r[i], dP.segment<3>(3 * i));
+  };
+  const auto body_change = [&](const NewtonVec& dP) {
+    Vec3 dv = Vec3::Zero(), dw = Vec3::Zero();
+    for (int i = 0; i < n; ++i) {
+      dv += dP.segment<3>(3 * i) * b.inv_mass;
+      dw += b.inv_inertia * pts.r[i].cross(Vec3(dP.segment<3>(3 * i)));
+    }
+    return dv.norm() + radius * dw.norm();
+  };
+  const double tol = kSweepTolerance * speed;
+  const NewtonVec P_start = P;
+  const Vec3 v_start = b.s->velocity, w_start = b.s->omega;
+  eval(true);
+  double f2 = F.squaredNorm();
+  Eigen::CompleteOrthogonalDecomposition<NewtonMat> cod(dim, dim);
+  NewtonVec dP(dim), trial(dim);
+  for (int it = 0; it < kNewtonMaxIterations; ++it) {
+    if (f2 == 0.0) {
+      res.converged = true;
+      break;
+    }
+    ++res.iterations;
+    J = NewtonMat::Identity(dim, dim) - dPhi;
+    if (fixed_radius)  // the normal impulses are not unknowns: their columns out, dP_n = 0
+      for (int i = 0; i < n; ++i) {
+        J.col(3 * i + 2).setZero();
+        J(3 * i + 2, 3 * i + 2) = 1.0;
+      }
+    cod.compute(J);
+    dP = -cod.solve(F);
+    // Backtracking on |F|^2 (the step from a kink can overshoot, and a step in the null space of
+    // W, free for the velocities, can leave the cones).
+    double alpha = 1.0;
+    bool accepted = false;
+    const NewtonVec P0 = P;
+    for (int ls = 0; ls < 30; ++ls) {
+      trial = alpha * dP;
+      P = P0 + trial;
+      apply(trial);
+      eval(false);
+      const double g2 = F.squaredNorm();
+      if (g2 <= (1.0 - 1e-4 * alpha) * f2) {
+        f2 = g2;
+        accepted = true;
+        break;
+      }
+      apply(-trial);
+      P = P0;
+      alpha *= 0.5;
+    }
+    if (!accepted) {
+      // No descent left: at the rounding floor if even the full step is below the tolerance.
+      eval(false);
+      res.converged = body_change(dP) <= tol && body_change(Phi - P) <= tol;
+      break;
+    }
+    eval(true);
+    if (body_change(trial) <= tol && body_change(Phi - P) <= tol) {
+      res.converged = true;
+      break;
+    }
+  }
+  // End on the cones: P = Phi(P).
+  const NewtonVec fix = Phi - P;
+  if (res.converged) {
+    apply(fix);
+    P = Phi;
+  } else {  // failed: back to the Gauss-Seidel iterate (the caller counts it unconverged)
+    b.s->velocity = v_start;
+    b.s->omega = w_start;
+    P = P_start;
+  }
+  for (int i = 0; i < n; ++i) {
+    pt[i] = Eigen::Vector2d(P(3 * i), P(3 * i + 1));
+    if (!fixed_radius) pn[i] = P(3 * i + 2);
+  }
+  return res;
+}
+
+// Newton with rho_i = 3 / tr W_ii, else (it can stall at a kink of Phi where F has a part outside
+// the range of the generalised Jacobian; which kink depends on rho) with rho / 8, then 8 rho, each
+// from the Gauss-Seidel iterate.
+NewtonResult polish_newton(const Body& b, const Points& pts, double pn[], Eigen::Vector2d pt[], double radius,
+                           double speed, const double* fixed_radius = nullptr) {
+  NewtonResult total;
+  for (const double scale : {1.0, 0.125, 8.0}) {
+    const NewtonResult r = newton_attempt(b, pts, pn, pt, radius, speed, fixed_radius, scale);
+    total.iterations += r.iterations;
+    if (r.converged) {
+      total.converged = true;
+      break;
+    }
+  }
+  return total;
+}
+
 // Projected Gauss-Seidel on the perfectly plastic frictional contact problem: at every point
 // P_n >= 0, u_n >= 0, P_n u_n = 0, |P_t| <= mu P_n, friction opposite the final slip. Each normal
 // update is the exact minimiser of the kinetic energy over P_n >= 0; the tangential one sticks or
@@ -272,16 +449,18 @@ SweepResult solve_plastic(const Body& b, const Points& pts, double pn[], Eigen::
                           double speed) {
   for (int it = 0; it < kMaxSweeps; ++it) {
     const SweepProbe probe(b);
+    Vec3& v = b.s->velocity;
+    Vec3& w = b.s->omega;
     for (int k = 0; k < pts.n; ++k) {
       const int i = it % 2 == 0 ? k : pts.n - 1 - k;
-      const Vec3& r = pts.r[i];
-      Vec3 u = b.point_velocity(r);
+      Vec3 u = v + w.cross(pts.r[i]);
       const double new_n = std::max(0.0, pn[i] - u.z() * pts.inv_wnn[i]);
       const double dn = new_n - pn[i];
       if (dn != 0.0) {
         pn[i] = new_n;
-        b.apply(r, Vec3(0.0, 0.0, dn));
-        u = b.point_velocity(r);
+        v.z() += dn * b.inv_mass;
+        w += dn * pts.az[i];
+        u += dn * pts.wz[i];
       }
       // Tangential: the sticking update, or on the cone's edge opposite the slip (whose fixed
       // points are the same Coulomb law as the exact disc minimiser's, at a fraction of the cost).
@@ -298,11 +477,16 @@ SweepResult solve_plastic(const Body& b, const Points& pts, double pn[], Eigen::
       }
       const Eigen::Vector2d dt = t - pt[i];
       pt[i] = t;
-      if (dt.x() != 0.0 || dt.y() != 0.0) b.apply(r, Vec3(dt.x(), dt.y(), 0.0));
+      if (dt.x() != 0.0 || dt.y() != 0.0) {
+        v.x() += dt.x() * b.inv_mass;
+        v.y() += dt.y() * b.inv_mass;
+        w += dt.x() * pts.ax[i] + dt.y() * pts.ay[i];
+      }
     }
     if (probe.change(b, radius) <= kSweepTolerance * speed) return {it + 1, true};
   }
-  return {kMaxSweeps, false};
+  const NewtonResult nr = polish_newton(b, pts, pn, pt, radius, speed);
+  return {kMaxSweeps + nr.iterations, nr.converged};
 }
 
 // Friction of the restitution phase: tangential impulses only, |P_t,i| <= radius_i, minimising the
@@ -331,7 +515,8 @@ SweepResult solve_friction(const Body& b, const Points& pts, const double radius
     }
     if (pts.n == 1 || probe.change(b, lever) <= kSweepTolerance * speed) return {pts.n == 1 ? 0 : it + 1, true};
   }
-  return {kMaxSweeps, false};
+  const NewtonResult nr = polish_newton(b, pts, nullptr, pt, lever, speed, radius);
+  return {kMaxSweeps + nr.iterations, nr.converged};
 }
 
 }  // namespace
@@ -385,6 +570,11 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
     pts.inv_wnn[i] = 1.0 / W(2, 2);
     pts.wtt[i] = W.topLeftCorner<2, 2>();
     pts.inv_wtt[i] = pts.wtt[i].inverse();
+    const Vec3& r = pts.r[i];
+    pts.ax[i] = b.inv_inertia * Vec3(0.0, r.z(), -r.y());
+    pts.ay[i] = b.inv_inertia * Vec3(-r.z(), 0.0, r.x());
+    pts.az[i] = b.inv_inertia * Vec3(r.y(), -r.x(), 0.0);
+    pts.wz[i] = W.col(2);
     u0n[i] = b.point_velocity(pts.r[i]).z();
   }
   const auto energy = [&](const RigidState& x) {
@@ -404,7 +594,8 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
   bool solved = false;
   if (c.n == 1) {
     solved = solve_plastic_single(b, pts, pn, pt);
-    if (!solved) ++res.corrections.fallbacks;  // a jam: no sliding direction stops the point
+    // A jam (no sliding direction found that stops the point): the general solve below takes it
+    // (Gauss-Seidel, finished by Newton), counted only if that does not converge.
   }
   if (!solved) {
     for (int i = 0; i < c.n; ++i) {

@@ -9,7 +9,10 @@
 //     (1/m) 1 - [r]x I_w^-1 [r]x, u the point's velocity v + w x r). Several: projected
 //     Gauss-Seidel where every update is the exact minimiser of the kinetic energy over its own
 //     block (normal: P_n >= 0; tangential: the disc |P_t| <= mu P_n, in the metric of W_tt), so
-//     every sweep lowers the energy; warm-started, symmetric sweeps, converged to 1e-13.
+//     every sweep lowers the energy; warm-started, symmetric sweeps, converged to 1e-11 of the
+//     speeds; a solve still unconverged at the sweep cap (an edge near the stick-slip boundary:
+//     two corners' compliance has rank 5) is finished by semismooth Newton on the Alart-Curnier
+//     equations, and counted (pgs_unconverged) only if that fails too.
 //  2. Restitution, energetic (Stronge): the normal impulses of compression, scaled by one k,
 //     release e^2 times the energy compression stored in the normal direction, where that is
 //     E_c = min(-W_n, -dE_c): W_n the work of the normal impulses along the compression (straight

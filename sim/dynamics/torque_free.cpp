@@ -406,6 +406,24 @@ Mat3 TorqueFreeRotation::general_orientation(const JacobiState& js, double t, Ve
   return g.frame * M;
 }
 
+Vec3 TorqueFreeRotation::bottom_row(double t) const {
+  if (kind_ == Kind::Still) return R0_.row(2).transpose();
+  if (kind_ == Kind::General && !gen_.steady) return orientation(t).row(2).transpose();
+  // symmetric_orientation, row 2 only.
+  const Symmetric& s = sym_;
+  const double alpha = s.precession_rate * t;
+  Vec3 r = s.along.row(2).transpose() + std::cos(alpha) * s.across.row(2).transpose() +
+           std::sin(alpha) * s.cross.row(2).transpose();
+  if (s.spin_rate != 0.0) {
+    const double beta = s.spin_rate * t;
+    const double cb = std::cos(beta), sb = std::sin(beta);
+    const double rp = r(s.p), rq = r(s.q);
+    r(s.p) = cb * rp + sb * rq;
+    r(s.q) = cb * rq - sb * rp;
+  }
+  return r;
+}
+
 Mat3 TorqueFreeRotation::orientation(double t) const {
   switch (kind_) {
     case Kind::Still:

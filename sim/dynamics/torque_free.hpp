@@ -19,6 +19,9 @@ class TorqueFreeRotation {
 
   // Orientation (principal->world) at time t >= 0 after the start.
   Mat3 orientation(double t) const;
+  // The orientation's bottom row (world z of each body axis) at time t: all a corner's height needs.
+  // Equal to orientation(t).row(2) up to rounding.
+  Vec3 bottom_row(double t) const;
   // Orientation and world angular velocity at time t.
   void state(double t, Mat3& R, Vec3& omega_world) const;
 
