@@ -17,14 +17,22 @@ Flight::Flight(const DieModel& model, const RigidState& s)
   contact_tol_ = 1e-9 * r;
 }
 
-RigidState Flight::state(double t) const {
+RigidState Flight::state_with(double t, const Mat3& R, const Vec3& omega) const {
   RigidState s;
   s.position = p0_ + v0_ * t;
   s.position.z() -= 0.5 * model_->gravity * t * t;
   s.velocity = v0_;
   s.velocity.z() -= model_->gravity * t;
-  rotation_.state(t, s.R, s.omega);
+  s.R = R;
+  s.omega = omega;
   return s;
+}
+
+RigidState Flight::state(double t) const {
+  Mat3 R;
+  Vec3 w;
+  rotation_.state(t, R, w);
+  return state_with(t, R, w);
 }
 
 ContactSearch Flight::next_contact(double t_limit) const {
@@ -54,17 +62,20 @@ ContactSearch Flight::next_contact(double t_limit) const {
       out.t = t_limit;
       return out;
     }
-    Mat3 R;
-    Vec3 w;
-    rotation_.state(t, R, w);
+    // Above the bounding sphere no corner can touch: jump before evaluating the rotation.
     const double zc = p0_.z() + v0_.z() * t - 0.5 * g * t * t;
-    const double vz = v0_.z() - g * t;
     if (zc > model_->bounding_radius && sphere_time > t) {
       t = sphere_time;
       continue;
     }
+    Mat3 R;
+    Vec3 w;
+    rotation_.state(t, R, w);
+    const double vz = v0_.z() - g * t;
 
-    double step = std::numeric_limits<double>::infinity();
+    // The step is min_i (zdot_i + sqrt(zdot_i^2 + 2 A z_i)) / A; division by A > 0 is monotone
+    // under rounding, so dividing the smallest numerator once gives the same number.
+    double numerator = std::numeric_limits<double>::infinity();
     int touching = -1;
     double touching_z = std::numeric_limits<double>::infinity();
     const int n = model_->vertex_count();
@@ -81,16 +92,16 @@ ContactSearch Flight::next_contact(double t_limit) const {
         continue;
       }
       const double zp = std::max(z, 0.0);
-      const double s = (zdot + std::sqrt(zdot * zdot + 2.0 * A * zp)) / A;
-      step = std::min(step, s);
+      numerator = std::min(numerator, zdot + std::sqrt(zdot * zdot + 2.0 * A * zp));
     }
     if (touching >= 0) {
       out.outcome = ContactSearch::Outcome::Contact;
       out.t = t;
       out.vertex = touching;
+      out.at = state_with(t, R, w);
       return out;
     }
-    t += std::max(step, min_step * (1.0 + t));
+    t += std::max(numerator / A, min_step * (1.0 + t));
   }
   out.outcome = ContactSearch::Outcome::IterationLimit;
   out.t = t;

@@ -70,7 +70,7 @@ TossResult run_paper(const DieModel& m, RigidState s, TossProbe* probe) {
     }
     if (timing) t0 = Clock::now();
     t_now += c.t;
-    RigidState before = flight.state(c.t);
+    RigidState before = c.at;  // = flight.state(c.t)
     before.R = orthonormal(before.R);
     s = before;
     const Impact imp = apply_vertex_impact(m, s, c.vertex);
