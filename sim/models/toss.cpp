@@ -151,7 +151,8 @@ TossResult toss(const DieModel& m, std::uint64_t seed, std::uint64_t index, Toss
   InitialState init;
   {
     const PhaseTimer timer(probe, Phase::Draw);
-    init = draw_initial_state(m.throw_, seed, index);
+    // `static` reads only the orientation (and the height, for the start's validity).
+    init = draw_initial_state(m.throw_, seed, index, /*motion=*/m.fidelity != Fidelity::Static);
   }
   return run(m, init, tiebreak_of(seed, index), probe);
 }
