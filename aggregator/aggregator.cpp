@@ -271,7 +271,7 @@ void Aggregator::on_status(const dicesim_lcm::worker_status& s, double now) {
   w.rate = std::isfinite(s.tosses_per_s) && s.tosses_per_s > 0 ? s.tosses_per_s : 0.0;
   if (s.run_id == 0 || s.state == 0) {  // has not got (or not yet compiled) our run: tell it again
     w.ready = false;
-    if (now - last_run_start_ > 0.2) publish_run_start(), last_run_start_ = now;
+    if (now - last_run_start_ > 0.02) publish_run_start(), last_run_start_ = now;
     return;
   }
   if (s.state == 2) {

@@ -1,7 +1,9 @@
-// dicesim bench: end-to-end throughput of this machine on a scene (per thread and scaled), and
-// where a toss spends its time. Micro-benchmarks live in bench/ (Google Benchmark).
+// dicesim bench: end-to-end throughput of this machine on a scene, per fidelity (one thread, then
+// all threads), and where a toss spends its time, phase by phase. Micro-benchmarks live in bench/
+// (Google Benchmark).
 #include <chrono>
 #include <cstdio>
+#include <sstream>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -16,72 +18,175 @@ namespace {
 
 struct BenchArgs {
   SceneArgs scene;
-  std::uint64_t tosses = 200000;
+  std::string fidelities;  // comma-separated, or "all"; empty: the scene's (or --fidelity)
+  CLI::Option* tosses_opt = nullptr;
+  std::uint64_t tosses = 0;  // 0: a default per fidelity (default_tosses)
   std::uint64_t seed = 1;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   bool json = false;
 };
 
-double timed_run(const DieModel& m, const BenchArgs& a, int threads, RunCounts& out) {
+// About a second of one core today for each fidelity.
+std::uint64_t default_tosses(Fidelity f) {
+  switch (f) {
+    case Fidelity::Static: return 1'000'000;
+    case Fidelity::Paper: return 400'000;
+    case Fidelity::Impulse: return 20'000;
+    case Fidelity::Stepped: return 2'000;
+    case Fidelity::Auto: break;
+  }
+  return 20'000;
+}
+
+double timed_run(const DieModel& m, std::uint64_t n, std::uint64_t seed, int threads, RunCounts& out) {
   RunConfig cfg;
-  cfg.seed = a.seed;
-  cfg.tosses = a.tosses;
+  cfg.seed = seed;
+  cfg.tosses = n;
   cfg.threads = threads;
   const auto t0 = std::chrono::steady_clock::now();
   out = run_tosses(m, cfg);
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-int run_bench(const BenchArgs& a) {
-  const DieModel m = compile(a.scene.load(), a.scene.path);
+// Which phase's count is "per toss" in words (the text report).
+const char* phase_unit(Phase p) {
+  switch (p) {
+    case Phase::Draw: return "draws";
+    case Phase::Search: return "searches";
+    case Phase::Impact: return "impacts";
+    case Phase::Steps: return "stepper runs";
+    case Phase::Rest: return "rest checks";
+  }
+  return "";
+}
+
+nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
+  SceneArgs sa = a.scene;
+  if (!fidelity.empty()) sa.fidelity = fidelity;
+  const DieModel m = compile(sa.load(), sa.path);
+  const std::uint64_t n = a.tosses > 0 ? a.tosses : default_tosses(m.fidelity);
 
   RunCounts one, many;
-  timed_run(m, a, 1, one);  // warm-up: caches, page faults, frequency
-  const double t1 = timed_run(m, a, 1, one);
-  const double tn = timed_run(m, a, a.threads, many);
-  const double rate1 = static_cast<double>(a.tosses) / t1;
-  const double raten = static_cast<double>(a.tosses) / tn;
+  timed_run(m, std::max<std::uint64_t>(1, n / 10), a.seed, 1, one);  // warm-up: caches, page faults, frequency
+  const double t1 = timed_run(m, n, a.seed, 1, one);
+  const double tn = timed_run(m, n, a.seed, a.threads, many);
+  const double rate1 = static_cast<double>(n) / t1;
+  const double raten = static_cast<double>(n) / tn;
 
-  // Where the time goes: one thread, instrumented (the clock reads cost a few percent).
+  // Where the time goes: one thread, each phase timed (two clock reads per phase entered; the
+  // instrumented run's own rate is reported, so their cost is visible).
   TossProbe probe;
   probe.timing = true;
-  const std::uint64_t n_probe = std::max<std::uint64_t>(1, a.tosses / 4);
+  const std::uint64_t n_probe = std::max<std::uint64_t>(1, n / 4);
   const auto p0 = std::chrono::steady_clock::now();
   for (std::uint64_t i = 0; i < n_probe; ++i) toss(m, a.seed, i, &probe);
   const double probe_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - p0).count();
-  const double other = std::max(0.0, probe_total - probe.flight_s - probe.impact_s);
-
-  const nlohmann::json j = {
-      {"scene", a.scene.path},
-      {"fidelity", to_string(m.fidelity)},
-      {"shape", m.kind},
-      {"faces", m.face_count()},
-      {"vertices", m.vertex_count()},
-      {"tosses", a.tosses},
-      {"tosses_per_s_1_thread", rate1},
-      {"threads", a.threads},
-      {"tosses_per_s", raten},
-      {"scaling_efficiency", raten / (rate1 * a.threads)},
-      {"identical_counts", one == many},
-      {"impacts_per_toss", static_cast<double>(one.bounces) / static_cast<double>(a.tosses)},
-      {"search_steps_per_flight", probe.flights ? static_cast<double>(probe.search_iterations) / probe.flights : 0.0},
-      {"time_split", {{"flight", probe.flight_s / probe_total}, {"impacts", probe.impact_s / probe_total},
-                      {"draw_and_other", other / probe_total}}}};
-  if (a.json) {
-    std::printf("%s\n", j.dump().c_str());
-  } else {
-    std::printf("%s  (fidelity %s, %s: %d corners, %d faces; %llu tosses)\n", a.scene.path.c_str(), to_string(m.fidelity),
-                m.kind.c_str(), m.vertex_count(), m.face_count(), static_cast<unsigned long long>(a.tosses));
-    std::printf("1 thread            %12.0f tosses/s  (%.3f us per toss)\n", rate1, 1e6 / rate1);
-    std::printf("%d threads %s        %12.0f tosses/s  (scaling efficiency %.1f%%)\n", a.threads,
-                a.threads < 10 ? " " : "", raten, 100.0 * raten / (rate1 * a.threads));
-    std::printf("identical counts    %s\n", one == many ? "yes" : "NO (a bug: please report)");
-    std::printf("impacts per toss    %.3f\nsearch steps/flight %.2f\n", j["impacts_per_toss"].get<double>(),
-                j["search_steps_per_flight"].get<double>());
-    std::printf("time split          flight %.1f%%, impacts %.1f%%, drawing the throw and other %.1f%%\n",
-                100.0 * probe.flight_s / probe_total, 100.0 * probe.impact_s / probe_total, 100.0 * other / probe_total);
+  double timed = 0.0;
+  nlohmann::json phases = nlohmann::json::object();
+  for (int k = 0; k < kPhaseCount; ++k) {
+    const auto p = static_cast<Phase>(k);
+    timed += probe.phase_s[k];
+    if (probe.phase_n[k] == 0) continue;
+    phases[to_string(p)] = {{"share", probe.phase_s[k] / probe_total},
+                            {"per_toss", static_cast<double>(probe.phase_n[k]) / static_cast<double>(n_probe)},
+                            {"us_each", 1e6 * probe.phase_s[k] / static_cast<double>(probe.phase_n[k])}};
   }
-  return one == many ? kExitOk : kExitFailed;
+  const double np = static_cast<double>(n_probe);
+  return {{"fidelity", to_string(m.fidelity)},
+          {"tosses", n},
+          {"tosses_per_s_1_thread", rate1},
+          {"us_per_toss_1_thread", 1e6 / rate1},
+          {"threads", a.threads},
+          {"tosses_per_s", raten},
+          {"scaling_efficiency", raten / (rate1 * a.threads)},
+          {"identical_counts", one == many},
+          {"impacts_per_toss", static_cast<double>(one.bounces) / static_cast<double>(n)},
+          {"search_steps_per_flight", probe.flights ? static_cast<double>(probe.search_iterations) / probe.flights : 0.0},
+          {"fixed_steps_per_toss", static_cast<double>(probe.steps) / np},
+          {"timed_tosses", n_probe},
+          {"timed_tosses_per_s", np / probe_total},
+          {"phases", phases},
+          {"other_share", std::max(0.0, probe_total - timed) / probe_total},
+          // Earlier shape, kept for scripts: flight = search, impacts, the rest.
+          {"time_split",
+           {{"flight", probe.phase_s[static_cast<int>(Phase::Search)] / probe_total},
+            {"impacts", probe.phase_s[static_cast<int>(Phase::Impact)] / probe_total},
+            {"draw_and_other",
+             std::max(0.0, probe_total - probe.phase_s[static_cast<int>(Phase::Search)] -
+                               probe.phase_s[static_cast<int>(Phase::Impact)]) /
+                 probe_total}}}};
+}
+
+void print_text(const nlohmann::json& r) {
+  const double rate1 = r["tosses_per_s_1_thread"].get<double>();
+  const int threads = r["threads"].get<int>();
+  std::printf("fidelity %s  (%llu tosses per measurement)\n", r["fidelity"].get<std::string>().c_str(),
+              static_cast<unsigned long long>(r["tosses"].get<std::uint64_t>()));
+  std::printf("  1 thread            %12.0f tosses/s  (%.3f us per toss)\n", rate1, 1e6 / rate1);
+  std::printf("  %d threads %s        %12.0f tosses/s  (scaling efficiency %.1f%%)\n", threads, threads < 10 ? " " : "",
+              r["tosses_per_s"].get<double>(), 100.0 * r["scaling_efficiency"].get<double>());
+  std::printf("  identical counts    %s\n", r["identical_counts"].get<bool>() ? "yes" : "NO (a bug: please report)");
+  std::printf("  impacts per toss    %.3f\n  search steps/flight %.2f\n", r["impacts_per_toss"].get<double>(),
+              r["search_steps_per_flight"].get<double>());
+  if (r["fixed_steps_per_toss"].get<double>() > 0)
+    std::printf("  fixed steps/toss    %.1f\n", r["fixed_steps_per_toss"].get<double>());
+  std::printf("  time split (one thread, each phase timed: %.0f tosses/s while timed)\n",
+              r["timed_tosses_per_s"].get<double>());
+  for (int k = 0; k < kPhaseCount; ++k) {
+    const auto p = static_cast<Phase>(k);
+    if (!r["phases"].contains(to_string(p))) continue;
+    const nlohmann::json& ph = r["phases"][to_string(p)];
+    std::printf("    %-8s %5.1f%%  %8.2f %s per toss, %9.3f us each\n", to_string(p), 100.0 * ph["share"].get<double>(),
+                ph["per_toss"].get<double>(), phase_unit(p), ph["us_each"].get<double>());
+  }
+  std::printf("    %-8s %5.1f%%  (result, counting, clock reads)\n", "other", 100.0 * r["other_share"].get<double>());
+}
+
+int run_bench(const BenchArgs& a) {
+  std::vector<std::string> list;
+  if (a.fidelities == "all") {
+    list = {"static", "paper", "impulse", "stepped"};
+  } else if (!a.fidelities.empty()) {
+    std::stringstream ss(a.fidelities);
+    for (std::string f; std::getline(ss, f, ',');) {
+      if (!parse_fidelity(f))
+        throw CLI::ValidationError("--fidelities", "'" + f + "' is not a fidelity (" + kFidelityChoices + ", or all)");
+      list.push_back(f);
+    }
+  } else {
+    list = {""};  // the scene's, or --fidelity
+  }
+  // Bad input first (the scene and every fidelity), before any measurement.
+  for (const std::string& f : list) {
+    SceneArgs sa = a.scene;
+    if (!f.empty()) sa.fidelity = f;
+    (void)compile(sa.load(), sa.path);
+  }
+
+  std::vector<nlohmann::json> results;
+  bool identical = true;
+  const DieModel first = compile(a.scene.load(), a.scene.path);
+  if (!a.json)
+    std::printf("%s  (%s: %d corners, %d faces)\n", a.scene.path.c_str(), first.kind.c_str(), first.vertex_count(),
+                first.face_count());
+  for (const std::string& f : list) {
+    results.push_back(bench_one(a, f));
+    identical = identical && results.back()["identical_counts"].get<bool>();
+    if (!a.json) print_text(results.back());
+    std::fflush(stdout);
+  }
+  if (a.json) {
+    nlohmann::json j = {{"scene", a.scene.path},
+                        {"shape", first.kind},
+                        {"faces", first.face_count()},
+                        {"vertices", first.vertex_count()},
+                        {"fidelities", results}};
+    // One fidelity: its fields at the top level as well (the earlier shape).
+    if (results.size() == 1)
+      for (const auto& [k, v] : results[0].items()) j[k] = v;
+    std::printf("%s\n", j.dump().c_str());
+  }
+  return identical ? kExitOk : kExitFailed;
 }
 
 }  // namespace
@@ -90,14 +195,36 @@ void register_bench(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<BenchArgs>();
   CLI::App* cmd = app.add_subcommand(
       "bench",
-      "Measure tosses per second on this machine: one thread, then all threads (scaling), and\n"
-      "the split of a toss's time between flight (contact search) and impacts.\n\n"
-      "Example:  dicesim bench scenes/paper/die1.toml --tosses 1000000");
+      "Measure tosses per second on this machine, per fidelity: one thread, then all threads\n"
+      "(scaling; the counts must be identical), and where a toss's time goes, by phase:\n"
+      "  draw     drawing the throw from (seed, toss index)\n"
+      "  search   exact flight and the search for the next contact (with the contact set)\n"
+      "  impacts  the impact law (paper: and its stop rule)\n"
+      "  steps    fixed steps: sustained contact (impulse), the whole toss (stepped)\n"
+      "  rest     rest checks (impulse), the quasi-static roll (static)\n"
+      "The split comes from a separate one-thread run that reads the clock around each phase; its\n"
+      "own rate is printed, so the cost of timing is visible. Wall clock: note the machine's load.\n\n"
+      "Examples:\n"
+      "  dicesim bench scenes/paper/die1.toml\n"
+      "  dicesim bench scenes/paper/die1.toml --fidelities all --json\n"
+      "  dicesim bench scenes/paper/die1.toml --fidelity impulse -n 20000 -j 1\n"
+      "  dicesim bench tradeoff scenes/paper/die1.toml      # accuracy against speed (own --help)");
   args->scene.add_to(cmd);
-  cmd->add_option("-n,--tosses", args->tosses, "Tosses per measurement")->capture_default_str()->check(CLI::Range(1ULL, 1ULL << 40));
+  cmd->add_option("--fidelities", args->fidelities,
+                  "Bench each of these in turn: a comma-separated list (static,paper,impulse,stepped,auto)\n"
+                  "or 'all' (default: the scene's fidelity, or --fidelity)")
+      ->type_name("LIST");
+  args->tosses_opt = cmd->add_option("-n,--tosses", args->tosses,
+                                     "Tosses per measurement (default: about a second of one core per fidelity:\n"
+                                     "static 1000000, paper 400000, impulse 20000, stepped 2000)")
+                         ->check(CLI::Range(1ULL, 1ULL << 40));
   cmd->add_option("--seed", args->seed, "Run seed")->capture_default_str();
   cmd->add_option("-j,--threads", args->threads, "Threads for the scaled measurement")->capture_default_str()->check(CLI::Range(1, 1024));
-  cmd->add_flag("--json", args->json, "One JSON object on stdout");
+  cmd->add_flag("--json", args->json,
+                "One JSON object on stdout: scene, shape, and per fidelity (\"fidelities\": [...]) tosses_per_s_1_thread,\n"
+                "tosses_per_s (all threads), scaling_efficiency, identical_counts, impacts_per_toss,\n"
+                "search_steps_per_flight, fixed_steps_per_toss, phases {name: {share, per_toss, us_each}},\n"
+                "other_share; with one fidelity its fields also at the top level");
   cmd->callback([args, &exit_code] { exit_code = run_bench(*args); });
 }
 

@@ -118,3 +118,16 @@ TEST(InitialState, OctantAxisPointsIntoPositiveOctant) {
     ASSERT_NEAR(s.omega.norm(), 10.0, 1e-12);
   }
 }
+
+TEST(InitialState, StaticDrawIsTheFullDrawsOrientationAndHeight) {
+  ThrowDef t;  // the defaults: uniform orientation, normal height, velocity and spin
+  for (std::uint64_t i = 0; i < 1000; ++i) {
+    const InitialState full = draw_initial_state(t, 4, i);
+    const InitialState part = draw_initial_state(t, 4, i, /*motion=*/false);
+    ASSERT_EQ(part.orientation, full.orientation);
+    ASSERT_EQ(part.com_position, full.com_position);
+    ASSERT_EQ(part.velocity, Vec3::Zero());
+    ASSERT_EQ(part.omega, Vec3::Zero());
+    ASSERT_NE(full.omega, Vec3::Zero());
+  }
+}

@@ -1,7 +1,12 @@
 #include "sim/dynamics/flight.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace dicesim {
 
@@ -17,15 +22,74 @@ Flight::Flight(const DieModel& model, const RigidState& s)
   contact_tol_ = 1e-9 * r;
 }
 
-RigidState Flight::state(double t) const {
+RigidState Flight::state_with(double t, const Mat3& R, const Vec3& omega) const {
   RigidState s;
   s.position = p0_ + v0_ * t;
   s.position.z() -= 0.5 * model_->gravity * t * t;
   s.velocity = v0_;
   s.velocity.z() -= model_->gravity * t;
-  rotation_.state(t, s.R, s.omega);
+  s.R = R;
+  s.omega = omega;
   return s;
 }
+
+RigidState Flight::state(double t) const {
+  Mat3 R;
+  Vec3 w;
+  rotation_.state(t, R, w);
+  return state_with(t, R, w);
+}
+
+namespace {
+
+// Corner heights above the floor, their rates, and the numerators of the advancement step,
+// zdot + sqrt(zdot^2 + 2 A max(z, 0)), for corners [0, n) (n rounded up to even: the arrays have
+// room). Every number is the same operation, in the same order, as the one-corner-at-a-time
+// expression (p = R v as Eigen 3.4 with SSE2 evaluates it: rows x and y as (R_i0 v0 + R_i1 v1) + R_i2 v2, row z as
+// R_20 v0 + (R_21 v1 + R_22 v2); tests/test_flight_search.cpp checks that the two paths agree), so the search is
+// bit-identical with or without SIMD; SSE2 does two corners per instruction.
+struct CornerPass {
+  double R[9];  // row-major
+  double zc, vz, wx, wy, rounding, two_A;
+};
+
+void corner_pass(const CornerPass& c, int n, const double* vx, const double* vy, const double* vzs, double* z,
+                 double* zdot, double* num) {
+#if defined(__SSE2__)
+  const __m128d r00 = _mm_set1_pd(c.R[0]), r01 = _mm_set1_pd(c.R[1]), r02 = _mm_set1_pd(c.R[2]);
+  const __m128d r10 = _mm_set1_pd(c.R[3]), r11 = _mm_set1_pd(c.R[4]), r12 = _mm_set1_pd(c.R[5]);
+  const __m128d r20 = _mm_set1_pd(c.R[6]), r21 = _mm_set1_pd(c.R[7]), r22 = _mm_set1_pd(c.R[8]);
+  const __m128d zc = _mm_set1_pd(c.zc), vz = _mm_set1_pd(c.vz), wx = _mm_set1_pd(c.wx), wy = _mm_set1_pd(c.wy);
+  const __m128d rounding = _mm_set1_pd(c.rounding), two_A = _mm_set1_pd(c.two_A), zero = _mm_setzero_pd();
+  for (int i = 0; i < n; i += 2) {
+    const __m128d x = _mm_load_pd(vx + i), y = _mm_load_pd(vy + i), w = _mm_load_pd(vzs + i);
+    const __m128d px = _mm_add_pd(_mm_add_pd(_mm_mul_pd(r00, x), _mm_mul_pd(r01, y)), _mm_mul_pd(r02, w));
+    const __m128d py = _mm_add_pd(_mm_add_pd(_mm_mul_pd(r10, x), _mm_mul_pd(r11, y)), _mm_mul_pd(r12, w));
+    const __m128d pz = _mm_add_pd(_mm_mul_pd(r20, x), _mm_add_pd(_mm_mul_pd(r21, y), _mm_mul_pd(r22, w)));
+    const __m128d zi = _mm_sub_pd(_mm_add_pd(zc, pz), rounding);
+    const __m128d zdi = _mm_add_pd(vz, _mm_sub_pd(_mm_mul_pd(wx, py), _mm_mul_pd(wy, px)));
+    const __m128d zp = _mm_max_pd(zero, zi);  // = std::max(z, 0.0), NaN and -0 included
+    const __m128d root = _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(zdi, zdi), _mm_mul_pd(two_A, zp)));
+    _mm_store_pd(z + i, zi);
+    _mm_store_pd(zdot + i, zdi);
+    _mm_store_pd(num + i, _mm_add_pd(zdi, root));
+  }
+#else
+  for (int i = 0; i < n; ++i) {
+    const double px = (c.R[0] * vx[i] + c.R[1] * vy[i]) + c.R[2] * vzs[i];
+    const double py = (c.R[3] * vx[i] + c.R[4] * vy[i]) + c.R[5] * vzs[i];
+    const double pz = c.R[6] * vx[i] + (c.R[7] * vy[i] + c.R[8] * vzs[i]);
+    z[i] = c.zc + pz - c.rounding;
+    zdot[i] = c.vz + (c.wx * py - c.wy * px);
+    num[i] = zdot[i] + std::sqrt(zdot[i] * zdot[i] + c.two_A * std::max(z[i], 0.0));
+  }
+#endif
+}
+
+// Dies with more corners than this search them one at a time (the same numbers, slower).
+constexpr int kSoaCorners = 64;
+
+}  // namespace
 
 ContactSearch Flight::next_contact(double t_limit) const {
   const double g = model_->gravity;
@@ -47,6 +111,19 @@ ContactSearch Flight::next_contact(double t_limit) const {
   // Near a contact it converges quadratically (like Newton's method from the safe side).
   constexpr int kMaxIterations = 100000;
   const double min_step = 1e-15;
+  const int n = model_->vertex_count();
+  const double rounding = model_->rounding;
+  // The corners as a structure of arrays (padded to an even count), for corner_pass.
+  const bool soa = n <= kSoaCorners;
+  alignas(16) double cx[kSoaCorners], cy[kSoaCorners], cz[kSoaCorners];
+  alignas(16) double z_of[kSoaCorners], zdot_of[kSoaCorners], num_of[kSoaCorners];
+  if (soa) {
+    for (int i = 0; i < n; ++i) {
+      const Vec3& v = model_->vertices[static_cast<std::size_t>(i)];
+      cx[i] = v.x(), cy[i] = v.y(), cz[i] = v.z();
+    }
+    if (n % 2 == 1) cx[n] = cy[n] = cz[n] = 0.0;  // a padding lane, computed and never read
+  }
   for (int it = 0; it < kMaxIterations; ++it) {
     out.iterations = it + 1;
     if (t > t_limit) {
@@ -54,43 +131,60 @@ ContactSearch Flight::next_contact(double t_limit) const {
       out.t = t_limit;
       return out;
     }
-    Mat3 R;
-    Vec3 w;
-    rotation_.state(t, R, w);
+    // Above the bounding sphere no corner can touch: jump before evaluating the rotation.
     const double zc = p0_.z() + v0_.z() * t - 0.5 * g * t * t;
-    const double vz = v0_.z() - g * t;
     if (zc > model_->bounding_radius && sphere_time > t) {
       t = sphere_time;
       continue;
     }
+    Mat3 R;
+    Vec3 w;
+    rotation_.state(t, R, w);
+    const double vz = v0_.z() - g * t;
 
-    double step = std::numeric_limits<double>::infinity();
+    // The step is min_i (zdot_i + sqrt(zdot_i^2 + 2 A z_i)) / A; division by A > 0 is monotone
+    // under rounding, so dividing the smallest numerator once gives the same number.
+    double numerator = std::numeric_limits<double>::infinity();
     int touching = -1;
     double touching_z = std::numeric_limits<double>::infinity();
-    const int n = model_->vertex_count();
-    const double rounding = model_->rounding;
-    for (int i = 0; i < n; ++i) {
-      const Vec3 p = R * model_->vertices[static_cast<std::size_t>(i)];
-      const double z = zc + p.z() - rounding;  // the lowest point of the corner's ball
-      const double zdot = vz + (w.x() * p.y() - w.y() * p.x());
-      if (z <= contact_tol_ && zdot < 0.0) {
-        if (z < touching_z) {
-          touching = i;
-          touching_z = z;
+    if (soa) {
+      const CornerPass pass{{R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)},
+                            zc, vz, w.x(), w.y(), rounding, 2.0 * A};
+      corner_pass(pass, n, cx, cy, cz, z_of, zdot_of, num_of);
+      for (int i = 0; i < n; ++i) {
+        if (z_of[i] <= contact_tol_ && zdot_of[i] < 0.0) {
+          if (z_of[i] < touching_z) {
+            touching = i;
+            touching_z = z_of[i];
+          }
+          continue;
         }
-        continue;
+        numerator = std::min(numerator, num_of[i]);
       }
-      const double zp = std::max(z, 0.0);
-      const double s = (zdot + std::sqrt(zdot * zdot + 2.0 * A * zp)) / A;
-      step = std::min(step, s);
+    } else {
+      for (int i = 0; i < n; ++i) {
+        const Vec3 p = R * model_->vertices[static_cast<std::size_t>(i)];
+        const double z = zc + p.z() - rounding;  // the lowest point of the corner's ball
+        const double zdot = vz + (w.x() * p.y() - w.y() * p.x());
+        if (z <= contact_tol_ && zdot < 0.0) {
+          if (z < touching_z) {
+            touching = i;
+            touching_z = z;
+          }
+          continue;
+        }
+        const double zp = std::max(z, 0.0);
+        numerator = std::min(numerator, zdot + std::sqrt(zdot * zdot + 2.0 * A * zp));
+      }
     }
     if (touching >= 0) {
       out.outcome = ContactSearch::Outcome::Contact;
       out.t = t;
       out.vertex = touching;
+      out.at = state_with(t, R, w);
       return out;
     }
-    t += std::max(step, min_step * (1.0 + t));
+    t += std::max(numerator / A, min_step * (1.0 + t));
   }
   out.outcome = ContactSearch::Outcome::IterationLimit;
   out.t = t;

@@ -21,6 +21,9 @@ struct ContactSearch {
   double t = 0.0;   // time after the flight's start
   int vertex = -1;  // the vertex that touches (Contact)
   int iterations = 0;
+  // Contact: the die's state at t, the very numbers Flight::state(t) returns (the search has
+  // already evaluated the rotation there; evaluating it again costs two sincos).
+  RigidState at;
 };
 
 class Flight {
@@ -36,6 +39,9 @@ class Flight {
   const Vec3& angular_momentum() const { return rotation_.angular_momentum(); }
 
  private:
+  // The state at t given the rotation's (R, omega) there.
+  RigidState state_with(double t, const Mat3& R, const Vec3& omega) const;
+
   const DieModel* model_;
   Vec3 p0_, v0_;
   TorqueFreeRotation rotation_;

@@ -41,6 +41,7 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
   };
   for (;;) {
     if (sustained) {
+      const PhaseTimer timer(probe, Phase::Steps);
       const StepperOutcome o =
           run_fixed_steps(m, s, t, r.bounces, m.contact_step, tiebreak, /*allow_liftoff=*/true, ImpactThreshold::Gravity, &stats);
       if (o.exit == StepperExit::Settled) return settle(o.face_down);
@@ -48,9 +49,14 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
       sustained = false;  // lift-off: back to exact flight
       s.R = Quat(s.R).normalized().toRotationMatrix();
     }
-    const int down = rest_face_down(m, s, tiebreak);
+    int down;
+    {
+      const PhaseTimer timer(probe, Phase::Rest);
+      down = rest_face_down(m, s, tiebreak);
+    }
     if (down >= 0) return settle(down);
 
+    PhaseTimer search_timer(probe, Phase::Search);  // flight, contact search and contact set
     const Flight flight(m, s);
     const ContactSearch c = flight.next_contact(m.max_time - t);
     if (probe) {
@@ -76,6 +82,8 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
         continue;
       }
     }
+    search_timer.stop();
+    const PhaseTimer impact_timer(probe, Phase::Impact);
     after_impact = false;
     t += c.t;
     s = at;

@@ -24,7 +24,7 @@ static double draw(TossRandom& rng, const NormalScalar& d) {
   return d.sd > 0.0 ? d.mean + d.sd * rng.normal() : d.mean;
 }
 
-InitialState draw_initial_state(const ThrowDef& thr, std::uint64_t seed, std::uint64_t toss) {
+InitialState draw_initial_state(const ThrowDef& thr, std::uint64_t seed, std::uint64_t toss, bool motion) {
   TossRandom rng(seed, toss);
   InitialState s;
 
@@ -48,6 +48,7 @@ InitialState draw_initial_state(const ThrowDef& thr, std::uint64_t seed, std::ui
   }
 
   s.com_position = Vec3(0.0, 0.0, draw(rng, thr.height));
+  if (!motion) return s;
   for (int k = 0; k < 3; ++k) s.velocity[k] = draw(rng, {thr.velocity.mean[k], thr.velocity.sd[k]});
 
   switch (thr.spin.kind) {

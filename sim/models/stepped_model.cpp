@@ -10,8 +10,10 @@ TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossPro
   double t = 0.0;
   int impacts = 0;
   StepperStats stats;
+  PhaseTimer timer(probe, Phase::Steps);
   const StepperOutcome o = run_fixed_steps(m, s, t, impacts, m.step, tiebreak, /*allow_liftoff=*/false,
                                            ImpactThreshold::Contact, &stats);
+  timer.stop();
   if (probe) {
     probe->flights += 1;
     probe->pgs_sweeps += stats.sweeps;

@@ -1,6 +1,5 @@
 #include "sim/models/toss.hpp"
 
-#include <chrono>
 #include <cmath>
 
 #include <cstring>
@@ -18,6 +17,17 @@ const char* to_string(TossStatus s) {
     case TossStatus::Settled: return "settled";
     case TossStatus::Unresolved: return "unresolved";
     case TossStatus::Invalid: return "invalid";
+  }
+  return "?";
+}
+
+const char* to_string(Phase p) {
+  switch (p) {
+    case Phase::Draw: return "draw";
+    case Phase::Search: return "search";
+    case Phase::Impact: return "impacts";
+    case Phase::Steps: return "steps";
+    case Phase::Rest: return "rest";
   }
   return "?";
 }
@@ -44,39 +54,35 @@ bool starts_valid(const DieModel& m, const RigidState& s) {
 // Re-orthonormalise between flights so that rounding cannot accumulate over many bounces.
 Mat3 orthonormal(const Mat3& R) { return Quat(R).normalized().toRotationMatrix(); }
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
 TossResult run_paper(const DieModel& m, RigidState s, TossProbe* probe) {
-  const bool timing = probe && probe->timing;
-  Clock::time_point t0;
   TossResult r;
   double t_now = 0.0;
   double last_impact = -1.0;
   int zeno_run = 0;
   for (;;) {
-    if (timing) t0 = Clock::now();
-    const Flight flight(m, s);
-    const ContactSearch c = flight.next_contact(m.max_time - t_now);
+    ContactSearch c;
+    {
+      const PhaseTimer timer(probe, Phase::Search);
+      const Flight flight(m, s);
+      c = flight.next_contact(m.max_time - t_now);
+    }
     if (probe) {
       probe->search_iterations += static_cast<std::uint64_t>(c.iterations);
       ++probe->flights;
-      if (timing) probe->flight_s += seconds_since(t0);
     }
     if (c.outcome != ContactSearch::Outcome::Contact) {
       r.status = TossStatus::Unresolved;
       r.t_end = t_now + c.t;
       return r;
     }
-    if (timing) t0 = Clock::now();
+    const PhaseTimer timer(probe, Phase::Impact);
     t_now += c.t;
-    RigidState before = flight.state(c.t);
+    RigidState before = c.at;  // = flight.state(c.t)
     before.R = orthonormal(before.R);
     s = before;
     const Impact imp = apply_vertex_impact(m, s, c.vertex);
     ++r.bounces;
     if (probe && probe->trace) probe->trace->push_back({r.bounces, t_now, before, s, c.vertex, imp.impulse});
-    if (timing) probe->impact_s += seconds_since(t0);
 
     // The seed's rule: the toss is over when the COM's rebound speed is below the threshold.
     if (s.velocity.z() < m.stop_speed) {
@@ -124,7 +130,10 @@ TossResult run(const DieModel& m, const InitialState& init, double tiebreak, Tos
   if (!starts_valid(m, s)) return TossResult{};  // status Invalid
   switch (m.fidelity) {
     case Fidelity::Paper: return run_paper(m, s, probe);
-    case Fidelity::Static: return run_static(m, s, tiebreak);
+    case Fidelity::Static: {
+      const PhaseTimer timer(probe, Phase::Rest);
+      return run_static(m, s, tiebreak);
+    }
     case Fidelity::Impulse: return run_impulse(m, s, tiebreak, probe);
     case Fidelity::Stepped: return run_stepped(m, s, tiebreak, probe);
     case Fidelity::Auto: break;  // resolved by compile(); never reaches a toss
@@ -139,7 +148,13 @@ TossResult toss_from(const DieModel& m, const InitialState& init, TossProbe* pro
 }
 
 TossResult toss(const DieModel& m, std::uint64_t seed, std::uint64_t index, TossProbe* probe) {
-  return run(m, draw_initial_state(m.throw_, seed, index), tiebreak_of(seed, index), probe);
+  InitialState init;
+  {
+    const PhaseTimer timer(probe, Phase::Draw);
+    // `static` reads only the orientation (and the height, for the start's validity).
+    init = draw_initial_state(m.throw_, seed, index, /*motion=*/m.fidelity != Fidelity::Static);
+  }
+  return run(m, init, tiebreak_of(seed, index), probe);
 }
 
 }  // namespace dicesim

@@ -1,6 +1,7 @@
 // One toss, top to bottom: draw the throw, fly, strike, repeat, read the face.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <vector>
 
@@ -45,12 +46,20 @@ struct BounceRecord {
   double impulse = 0.0;
 };
 
+// Where a toss's time goes, for `dicesim bench` (TossProbe::timing). Every model times the phases
+// it has: drawing the throw; the exact flight and its contact search (with the contact set);
+// impacts (the impulse law and, for `paper`, the stop rule); fixed steps of sustained contact
+// (`impulse`) or of the whole toss (`stepped`); rest checks.
+enum class Phase : std::uint8_t { Draw, Search, Impact, Steps, Rest };
+inline constexpr int kPhaseCount = 5;
+const char* to_string(Phase p);
+
 // Optional instruments for one or many tosses (null in the hot path: nothing is recorded).
 struct TossProbe {
   std::vector<BounceRecord>* trace = nullptr;  // every impact appended
-  bool timing = false;                         // accumulate the split below (costs ~5%)
-  double flight_s = 0.0;                       // contact searches and flight set-up
-  double impact_s = 0.0;                       // impulses and the stop rule
+  bool timing = false;                         // time the phases below (two clock reads per phase entered)
+  double phase_s[kPhaseCount] = {};            // seconds in each Phase
+  std::uint64_t phase_n[kPhaseCount] = {};     // times each Phase was entered
   std::uint64_t search_iterations = 0;         // conservative-advancement steps
   std::uint64_t flights = 0;
   // `impulse` and `stepped`: Gauss-Seidel sweeps of every contact solve, fixed steps taken, and
@@ -61,6 +70,31 @@ struct TossProbe {
   std::uint64_t located_steps = 0;  // fixed steps shortened to the instant a new corner touches
   double max_energy_gain = 0.0;
   RigidState* final_state = nullptr;           // impulse, stepped: the state when the toss ended
+};
+
+// Times one phase of a toss into probe->phase_s while in scope; reads no clock (and costs one
+// test of a pointer that is null in the hot path) unless probe->timing.
+class PhaseTimer {
+ public:
+  PhaseTimer(TossProbe* probe, Phase phase) : probe_(probe && probe->timing ? probe : nullptr), phase_(phase) {
+    if (probe_) t0_ = std::chrono::steady_clock::now();
+  }
+  ~PhaseTimer() { stop(); }
+  // Ends the phase before the scope does (once).
+  void stop() {
+    if (!probe_) return;
+    const auto k = static_cast<std::size_t>(phase_);
+    probe_->phase_s[k] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+    ++probe_->phase_n[k];
+    probe_ = nullptr;
+  }
+  PhaseTimer(const PhaseTimer&) = delete;
+  PhaseTimer& operator=(const PhaseTimer&) = delete;
+
+ private:
+  TossProbe* probe_;
+  Phase phase_;
+  std::chrono::steady_clock::time_point t0_;
 };
 
 // Chatter guard (`paper`): this many impacts in a row, each less than kZenoInterval after the

@@ -195,11 +195,17 @@ bool WorkerCore::step(double now) {
   for (std::uint64_t k = 0; k < n; ++k) {
     const std::uint64_t i = l.next + k;
     const bool traced = spec.trace_every > 0 && i % static_cast<std::uint64_t>(spec.trace_every) == 0;
-    TossProbe probe;
     records.clear();
-    probe.trace = &records;
-    // The probe only records: the result is the same toss as without it.
-    const TossResult r = toss(model, spec.seed, i, traced ? &probe : nullptr);
+    // The probe only records: the result is the same toss as without it. (Built only when
+    // traced: the untraced toss, nearly all of them, passes no probe.)
+    TossResult r;
+    if (traced) {
+      TossProbe probe;
+      probe.trace = &records;
+      r = toss(model, spec.seed, i, &probe);
+    } else {
+      r = toss(model, spec.seed, i);
+    }
     b.outcomes[k] = static_cast<std::int8_t>(r.status == TossStatus::Settled ? r.outcome : -1);
     b.statuses[k] = static_cast<std::int8_t>(r.status);
     b.bounces[k] = r.bounces;
