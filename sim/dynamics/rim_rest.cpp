@@ -1,0 +1,114 @@
+#include "sim/dynamics/rim_rest.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "sim/dynamics/contact.hpp"
+
+namespace dicesim {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Distance from the COM (origin) to the nearest point of the circle centre c, axis k, radius a.
+double circle_distance(const Vec3& c, const Vec3& k, double a) {
+  const Vec3 w = -c;
+  const double par = w.dot(k);
+  const double perp = (w - par * k).norm();
+  return std::sqrt(par * par + (perp - a) * (perp - a));
+}
+
+}  // namespace
+
+void compute_rim_rest_geometry(DieModel& m) {
+  const Rims& rim = m.rims;
+  const Vec3& k = rim.axis;
+  const Vec3& o = rim.centre;
+  const double ok = o.dot(k), o_perp = (o - ok * k).norm();
+  const double r = m.rounding;
+  m.face_height = {ok + rim.half + r, -ok + rim.half + r, rim.radius - o_perp + r};
+  m.face_hold = {rim.radius - o_perp, rim.radius - o_perp, rim.half - std::abs(ok)};
+  const double e0 = circle_distance(o + rim.half * k, k, rim.radius) + r;
+  const double e1 = circle_distance(o - rim.half * k, k, rim.radius) + r;
+  m.face_escape = {e0, e1, std::min(e0, e1)};
+  m.face_tip_ratio.resize(3);
+  for (int f = 0; f < 3; ++f) m.face_tip_ratio[f] = m.face_hold[f] / m.face_height[f];
+  const Mat3 I = m.principal_moments.asDiagonal();
+  m.face_gyro = {k.cross(I * k).norm(), k.cross(I * k).norm(), 0.0};
+  m.face_area = {kPi * rim.radius * rim.radius, kPi * rim.radius * rim.radius, 2.0 * kPi * rim.radius * 2.0 * rim.half};
+  m.max_escape = 0.0;
+  for (int f = 0; f < 3; ++f)
+    if (m.face_hold[f] >= 0.0) m.max_escape = std::max(m.max_escape, m.face_escape[f]);
+}
+
+int rim_quasi_static_down(const DieModel& m, const Mat3& R, double tiebreak) {
+  const Rims& rim = m.rims;
+  const Vec3& k = rim.axis;
+  const Vec3& o = rim.centre;
+  const bool valley = std::abs(o.dot(k)) < rim.half;
+  const bool face_stable = (o - o.dot(k) * k).norm() < rim.radius;
+  constexpr double kStep = 1e-3;  // rad
+  Vec3 d = R.transpose() * Vec3(0.0, 0.0, -1.0);
+  for (int it = 0; it < 20000; ++it) {
+    const double dk = d.dot(k);
+    const Vec3 dp = d - dk * k;
+    const double np = dp.norm();
+    if (np < kStep && face_stable) return dk > 0.0 ? 0 : 1;
+    if (std::abs(dk) < 1e-15 && valley) return 2;  // exactly on the side
+    Vec3 g = o + (dk > 0.0 ? rim.half : -rim.half) * k;
+    if (np > 0.0) g += rim.radius * dp / np;
+    Vec3 gt = g - g.dot(d) * d;
+    if (gt.norm() <= 1e-12 * rim.radius) {  // balanced exactly: the toss decides the way
+      const Vec3 u = d.unitOrthogonal(), v = d.cross(u);
+      const double a = 2.0 * kPi * tiebreak;
+      gt = std::cos(a) * u + std::sin(a) * v;
+    }
+    const Vec3 next = (d - kStep * gt.normalized()).normalized();
+    if ((next.dot(k) > 0.0) != (dk > 0.0) && valley) return 2;  // reached the side's valley
+    d = next;
+  }
+  return -1;
+}
+
+int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) {
+  const Vec3 wb = s.R.transpose() * s.omega;
+  const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
+  const double mg = m.mass * m.gravity;
+  if (ke + mg * s.position.z() >= mg * m.max_escape) return -1;
+  const double low = s.position.z() + rim_lowest(m, s.R);
+  const double energy = ke + mg * (s.position.z() + std::max(0.0, -low));
+  const int basin = rim_quasi_static_down(m, s.R, tiebreak);
+  if (basin >= 0 && energy < mg * m.face_escape[static_cast<std::size_t>(basin)] * (1.0 - 1e-9)) return basin;
+  return -1;
+}
+
+double rim_lowest_excluding(const DieModel& m, const Mat3& R, const ContactSet& c) {
+  double low = kInf;
+  int j = 0;  // c.vertex is ascending
+  for (int i = 0; i < kRimFeatures; ++i) {
+    if (j < c.n && c.vertex[j] == i) {
+      ++j;
+      continue;
+    }
+    low = std::min(low, rim_point(m, R, i).z());
+  }
+  return low;
+}
+
+void apply_rolling_resistance(const DieModel& m, RigidState& s, const ContactSet& c, double normal_impulse) {
+  if (c.n == 0 || !(normal_impulse > 0.0)) return;
+  const Vec3 wh(s.omega.x(), s.omega.y(), 0.0);
+  const double w = wh.norm();
+  if (w <= 0.0) return;
+  double delta = 0.0;
+  for (int i = 0; i < c.n; ++i) delta += m.vertex_rolling[static_cast<std::size_t>(c.vertex[i])];
+  delta /= c.n;
+  if (delta <= 0.0) return;
+  const Vec3 u = wh / w;
+  const Vec3 inv_u = s.R * (s.R.transpose() * u).cwiseQuotient(m.principal_moments);  // I_w^-1 u
+  const double lam = std::min(delta * normal_impulse, w / u.dot(inv_u));
+  s.omega -= lam * inv_u;
+}
+
+}  // namespace dicesim
