@@ -50,6 +50,17 @@ int rim_quasi_static_down(const DieModel& m, const Mat3& R, double tiebreak) {
   const bool face_stable = (o - o.dot(k) * k).norm() < rim.radius;
   constexpr double kStep = 1e-3;  // rad
   Vec3 d = R.transpose() * Vec3(0.0, 0.0, -1.0);
+  const double o_perp = (o - o.dot(k) * k).norm();
+  if (o_perp <= 1e-12 * rim.radius && valley) {
+    // COM on the axis: the roll stays in the plane of the axis and the down direction; at angle
+    // theta from the face normal sigma = (s o.k + b) cos theta + a sin theta, so the die falls
+    // onto the face iff a cos theta > (s o.k + b) sin theta, else onto its side.
+    const double dk = d.dot(k), s = dk >= 0.0 ? 1.0 : -1.0;
+    const double lhs = rim.radius * std::abs(dk), rhs = (s * o.dot(k) + rim.half) * (d - dk * k).norm();
+    const int face = dk >= 0.0 ? 0 : 1;
+    if (lhs == rhs) return tiebreak < 0.5 ? face : 2;
+    return lhs > rhs ? face : 2;
+  }
   for (int it = 0; it < 20000; ++it) {
     const double dk = d.dot(k);
     const Vec3 dp = d - dk * k;
@@ -80,7 +91,27 @@ int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) 
   const double energy = ke + mg * (s.position.z() + std::max(0.0, -low));
   const int basin = rim_quasi_static_down(m, s.R, tiebreak);
   if (basin >= 0 && energy < mg * m.face_escape[static_cast<std::size_t>(basin)] * (1.0 - 1e-9)) return basin;
-  return -1;
+
+  // Lying flat on a face, sliding or spinning but not rocking (as a polytope's face, rest.hpp):
+  // the face's tripod on the floor with vanishing normal velocity, friction too weak to tip it
+  // (mu below face_tip_ratio), and the spin about the vertical within what gravity holds against
+  // the gyroscopic torque w^2 |n x I n| (0 for a symmetric coin). Such a coin cannot turn over.
+  const double kz = s.R.row(2).dot(m.rims.axis);
+  if (std::abs(kz) < 0.999) return -1;
+  const int down = kz < 0.0 ? 0 : 1;  // face 0 (heads face) down when the axis points down
+  const std::size_t di = static_cast<std::size_t>(down);
+  const double flat_tol = 1e-6 * m.bounding_radius;
+  const double v_tol = 1e-3 * std::sqrt(m.gravity * m.bounding_radius);
+  const double spin = s.omega.z();
+  if (!(m.face_hold[di] >= 0.0 && m.max_friction < 0.999 * m.face_tip_ratio[di] &&
+        spin * spin * m.face_gyro[di] < 0.999 * mg * m.face_hold[di]))
+    return -1;
+  for (int j = 0; j < 3; ++j) {
+    const Vec3 r = rim_point(m, s.R, 3 * down + j);
+    if (s.position.z() + r.z() - std::min(low, 0.0) > flat_tol) return -1;
+    if (std::abs((s.velocity + s.omega.cross(r)).z()) > v_tol) return -1;
+  }
+  return down;
 }
 
 double rim_lowest_excluding(const DieModel& m, const Mat3& R, const ContactSet& c) {
