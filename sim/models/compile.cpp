@@ -115,6 +115,8 @@ void finish_model(DieModel& m, const SceneDef& scene, const std::string& origin)
   m.throw_ = scene.throw_;
   m.catch_end = scene.sim.end == EndKind::Catch;
   resolve_fidelity(scene, m);
+  if (m.catch_end)
+    m.fidelity_reason += "; sim.end = \"catch\": the die flies untouched to the catch (no floor), so no fidelity's contact model plays a part";
 
   // The die must start above the floor. With a random orientation any corner may point down, so
   // the mean COM height must clear the bounding sphere; with a fixed one, the lowest corner.
