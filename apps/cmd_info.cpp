@@ -20,7 +20,11 @@ void print_info(const std::string& path, const DieModel& m) {
   std::printf("shape              %s: %d corners, %d faces, %d outcomes, read %s%s\n", m.kind.c_str(), m.vertex_count(),
               m.face_count(), m.outcomes(), m.read_down ? "down (the face on the floor)" : "up",
               m.convex ? "" : "  (not convex: contact uses its hull)");
-  if (m.rounding > 0.0) std::printf("rounding           %.6g m (edges and corners)\n", m.rounding);
+  if (m.curved())
+    std::printf("cylinder           radius %.6g m, height %.6g m; faces: 0 heads (+z), 1 tails (-z), 2 the curved side (edge);\n"
+                "                   corners: each rim's lowest point and two rim points 120 deg from it\n",
+                m.rims.radius + m.rounding, 2.0 * (m.rims.half + m.rounding));
+  if (m.rounding > 0.0) std::printf("rounding           %.6g m (%s)\n", m.rounding, m.curved() ? "rims" : "edges and corners");
   std::printf("mass               %.9g kg\n", mp.mass);
   std::printf("centre of mass     (%+.6e, %+.6e, %+.6e) m from the geometric centre (%.4f mm off)\n", mp.com.x(), mp.com.y(),
               mp.com.z(), 1e3 * mp.com.norm());

@@ -378,7 +378,7 @@ material = "steel"
 )", "scenes/x.toml"); });
   EXPECT_EQ(std::string(e.what()),
             "scenes/x.toml: materials.steel.densty = 7848.0: unknown key 'densty' in [materials.steel]; "
-            "allowed: density, restitution, friction");
+            "allowed: density, restitution, friction, rolling_resistance");
 
   const SceneError spin = parse_error(kMinimal + "[throw.spin]\nsdd = 3\n");
   EXPECT_EQ(spin.key(), "throw.spin.sdd");
@@ -503,7 +503,7 @@ TEST(SceneErrors, UnknownFidelityAndKinds) {
 
   const SceneError spin = parse_error(kMinimal + "[throw.spin]\nkind = \"wild\"\n");
   EXPECT_EQ(spin.key(), "throw.spin.kind");
-  EXPECT_EQ(spin.allowed(), "must be one of: \"normal\", \"random-axis\", \"octant-axis\", \"fixed\"");
+  EXPECT_EQ(spin.allowed(), "must be one of: \"normal\", \"random-axis\", \"octant-axis\", \"body-axis\", \"fixed\"");
 
   const SceneError axis = parse_error(kMinimal + "[throw.spin]\nkind = \"random-axis\"\nmean = [1, 2, 3]\n");
   EXPECT_EQ(axis.key(), "throw.spin.mean");

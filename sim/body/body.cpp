@@ -152,10 +152,56 @@ ConvexShape hull_or_error(const std::vector<Vec3>& points, const std::string& or
   }
 }
 
+// A cylinder: exact mass properties (regions included) and per-rim materials.
+Body build_cylinder(const SceneDef& scene, const std::string& origin) {
+  const DieDef& die = scene.die;
+  Body b;
+  b.kind = "cylinder";
+  b.cylinder = CylinderShape{die.radius, die.height, die.rounding};
+  if (!(die.rounding < std::min(die.radius, 0.5 * die.height)))
+    throw SceneError(origin, "die.rounding", num(die.rounding), "must be below min(radius, height/2)");
+  const CylinderShape c = b.cylinder;
+  const SolidMoments solid = [c](const std::vector<HalfSpace>& cuts) { return cylinder_moments(c, cuts); };
+  check_regions(die, solid, solid({}).volume, origin);
+  b.face_labels = {die.cylinder_labels[0], die.cylinder_labels[1], die.cylinder_labels[2]};
+  b.mass = layered_mass(die, scene.materials, solid);
+  if (!(b.mass.mass > 0.0) || !b.mass.inertia.allFinite())
+    throw SceneError(origin, "die", "", "the die has no mass; check its size and the densities");
+  // Each rim's materials: the volume mix in the outer skin of its face (a slab of thickness
+  // max(rounding, 1e-6 height)), the same for the rim's three features.
+  const double skin = std::max(die.rounding, 1e-6 * die.height);
+  for (int k = 0; k < 2; ++k) {
+    const double sgn = k == 0 ? 1.0 : -1.0;
+    const std::vector<HalfSpace> slab = {{Vec3(0, 0, -sgn), -(0.5 * die.height - skin)}};
+    const double whole = solid(slab).volume;
+    const MaterialDef& base = scene.materials.at(die.base_material);
+    double fb = 1.0, e = 0.0, mu = 0.0, rr = 0.0;
+    for (const RegionDef& r : die.regions) {
+      std::vector<HalfSpace> cuts = slab;
+      cuts.insert(cuts.end(), r.half_spaces.begin(), r.half_spaces.end());
+      const double f = whole > 0.0 ? solid(cuts).volume / whole : 0.0;
+      if (f <= 0.0) continue;
+      const MaterialDef& mat = scene.materials.at(r.material);
+      fb -= f;
+      e += f * mat.restitution;
+      mu += f * mat.friction;
+      rr += f * mat.rolling_resistance;
+    }
+    fb = std::max(0.0, fb);
+    for (int j = 0; j < 3; ++j) {
+      b.vertex_restitution.push_back(e + fb * base.restitution);
+      b.vertex_friction.push_back(mu + fb * base.friction);
+      b.vertex_rolling.push_back(rr + fb * base.rolling_resistance);
+    }
+  }
+  return b;
+}
+
 }  // namespace
 
 Body build_body(const SceneDef& scene, const std::string& origin) {
   const DieDef& die = scene.die;
+  if (die.shape == ShapeKind::Cylinder) return build_cylinder(scene, origin);
   if (die.shape == ShapeKind::Box && die.rounding == 0.0) return build_box(scene, origin);
 
   Body b;

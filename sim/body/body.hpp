@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/body/cylinder.hpp"
 #include "sim/body/mass_properties.hpp"
 #include "sim/body/shape.hpp"
 #include "sim/scene/scene.hpp"
@@ -24,6 +25,12 @@ struct Body {
   std::vector<double> vertex_restitution;   // per shape vertex, from the materials around it
   std::vector<double> vertex_friction;
   bool convex = true;                       // false: a mesh whose solid is not its hull
+  // A cylinder (kind "cylinder", cylinder.radius > 0): `shape` is empty; its contact features are
+  // points of the two rim circles (sim/body/rim.hpp); face_labels = heads, tails, edge; the
+  // per-vertex materials are per rim feature (3 per rim: +z rim first), each the mix of the
+  // materials in its face's outer skin.
+  CylinderShape cylinder;
+  std::vector<double> vertex_rolling;       // per vertex (or rim feature): rolling resistance (m)
 };
 
 // Builds and checks the body a scene describes. Throws SceneError (key, value, allowed range) for

@@ -17,6 +17,22 @@
 
 namespace dicesim {
 
+// A curved die (a cylinder) in the body frame: its core's two rim circles, centre +- half * axis,
+// radius `radius` (the rounding, DieModel::rounding, is swept over them as over a polytope's
+// corners). Its contact features are moving points of those circles, not corners: feature
+// 3 k + j is on rim k (0: the +axis rim, heads' side; 1: the -axis rim), j = 0 the rim's lowest
+// point, j = 1, 2 the points 120 deg either side of it (so that a face lying flat stands on a
+// tripod). sim/body/rim.hpp computes them.
+struct Rims {
+  bool on = false;
+  Vec3 centre = Vec3::Zero();    // the cylinder's geometric centre
+  Vec3 axis = Vec3::UnitZ();     // unit, toward the heads face
+  Vec3 perp = Vec3::UnitX();     // a unit vector perpendicular to axis (the lowest point of a flat rim)
+  double radius = 0.0;           // core rim radius (outer radius - rounding)
+  double half = 0.0;             // core half-height (outer height / 2 - rounding)
+};
+inline constexpr int kRimFeatures = 6;
+
 struct DieModel {
   // Geometry in the body (principal, COM-centred) frame.
   std::vector<Vec3> vertices;              // the core's corners
@@ -24,6 +40,8 @@ struct DieModel {
   std::vector<double> vertex_friction;
   double rounding = 0.0;                   // radius of the ball swept over the core (m)
   double bounding_radius = 0.0;            // max |vertex| + rounding from the COM
+  Rims rims;                               // a cylinder: vertices is empty, features are rim points
+  std::vector<double> vertex_rolling;      // a cylinder: per rim feature, rolling resistance (m)
   // Corner adjacency along the core's edges (CSR): neighbours of v are
   // vertex_adj[vertex_adj_begin[v] .. vertex_adj_begin[v + 1]).
   std::vector<int> vertex_adj_begin, vertex_adj;
@@ -74,6 +92,7 @@ struct DieModel {
   double stop_speed = 0.1;
   int max_bounces = 1000;
   double max_time = 60.0;
+  bool catch_end = false;  // sim.end = "catch": exact flight to the catch time, no floor
 
   ThrowDef throw_;  // distributions of the initial state (geometric frame for orientation)
   std::string name;
@@ -81,7 +100,9 @@ struct DieModel {
   bool convex = true;        // false: a mesh whose solid is not its hull (contact uses the hull)
 
   int face_count() const { return static_cast<int>(face_normals.size()); }
-  int vertex_count() const { return static_cast<int>(vertices.size()); }
+  // Corners, or a cylinder's rim features.
+  int vertex_count() const { return rims.on ? kRimFeatures : static_cast<int>(vertices.size()); }
+  bool curved() const { return rims.on; }
   int outcomes() const { return static_cast<int>(outcome_labels.size()); }
   std::span<const int> face_vertices(int f) const {
     return {face_loop.data() + face_begin[static_cast<std::size_t>(f)],

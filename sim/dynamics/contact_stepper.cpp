@@ -6,6 +6,7 @@
 #include "sim/dynamics/contact.hpp"
 #include "sim/dynamics/friction_impact.hpp"
 #include "sim/dynamics/rest.hpp"
+#include "sim/dynamics/rim_rest.hpp"
 
 namespace dicesim {
 
@@ -40,6 +41,10 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
                                 double t) const {
   // At t = 0 the step's own orientation, bit for bit as touching_corners saw it (so a corner left
   // out of the contact set is above the tolerance here too).
+  if (m_->curved()) {  // a cylinder's rim points need the whole orientation
+    const Mat3 R = t == 0.0 ? rot_start_ : rot.orientation(t);
+    return p.z() + v.z() * t + rim_lowest_excluding(*m_, R, c);
+  }
   const Vec3 z_row = t == 0.0 ? Vec3(rot_start_.row(2).transpose()) : rot.bottom_row(t);
   const auto& verts = m_->vertices;
   const int nv = static_cast<int>(verts.size());
@@ -65,6 +70,7 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   a.next.n = 0;
   s.velocity.z() -= m.gravity * d;
   if (c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next);
+  if (m.curved() && c.n > 0) apply_rolling_resistance(m, s, c, a.sup.normal_impulse);
 
   // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact).
   const Vec3 L = world_inertia(m, s.R) * s.omega;
@@ -140,7 +146,9 @@ int FixedStepper::step(RigidState& s) {
     // itself in the bracket the trials have found.
     const Vec3 z_row = s0.R.row(2).transpose();
     double g_lo = std::numeric_limits<double>::infinity();
-    {
+    if (m.curved()) {
+      g_lo = s0.position.z() + rim_lowest_excluding(m, s0.R, c);
+    } else {
       int j = 0;
       for (int i = 0; i < static_cast<int>(m.vertices.size()); ++i) {
         if (j < c.n && c.vertex[j] == i) {
@@ -282,7 +290,8 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       const ContactSet c = touching_corners(m, s, 1e-6 * r);
       Vec3 axis;
       if (c.n == 2) {
-        axis = (s.R * (m.vertices[c.vertex[1]] - m.vertices[c.vertex[0]])).normalized();
+        axis = m.curved() ? (contact_point(m, s.R, c.vertex[1]) - contact_point(m, s.R, c.vertex[0])).normalized()
+                          : (s.R * (m.vertices[c.vertex[1]] - m.vertices[c.vertex[0]])).normalized();
         if (std::fmod(tiebreak * 4096.0, 1.0) < 0.5) axis = -axis;
       } else {
         const double a = 2.0 * kPi * tiebreak;

@@ -9,6 +9,55 @@
 #endif
 
 namespace dicesim {
+namespace {
+
+// A rim circle's height over the floor at time s ahead is bounded below, point by point, by
+//   z(phi) + zdot(phi) s - A s^2 / 2  =  a0 + a1 s - rho |p + q s| - A s^2 / 2  =: g(s)
+// (z, zdot sinusoids in the rim angle phi; its minimum over phi in closed form). g is concave and
+// g(0) is the rim's lowest height, so every s in (0, s*] with g(s) >= 0 is a step that cannot pass
+// a contact. Chords of a concave g lie below it: from a safe point and an overshoot (Newton from
+// the right stays right of s*), the chord's zero is a new safe point. Returns a safe step.
+double rim_safe_step(double a0, double a1, const Eigen::Vector2d& p, const Eigen::Vector2d& q, double rho,
+                     double A) {
+  const auto g = [&](double s) { return a0 + a1 * s - rho * (p + q * s).norm() - 0.5 * A * s * s; };
+  const auto dg = [&](double s) {
+    const Eigen::Vector2d x = p + q * s;
+    const double n = x.norm();
+    return a1 - (n > 0.0 ? rho * x.dot(q) / n : -rho * q.norm()) - A * s;
+  };
+  // A rim slightly below the floor but rising counts as on it (as a corner does): g(0) = 0.
+  const double z = g(0.0);
+  if (z < 0.0) a0 -= z;
+  const double z0 = std::max(0.0, z);
+  // Safe: every rim point at least as low and falling as fast as the worst of them.
+  const double vmin = a1 - rho * q.norm();
+  double lo = (vmin + std::sqrt(vmin * vmin + 2.0 * A * z0)) / A;
+  // Overshoot: the lowest point's own bound (g is below it).
+  const double vlow = dg(0.0);
+  double hi = (vlow + std::sqrt(vlow * vlow + 2.0 * A * z0)) / A;
+  if (!(hi > lo)) return lo;
+  double g_lo = g(lo), g_hi = g(hi);
+  if (g_hi >= 0.0) return hi;
+  for (int it = 0; it < 6 && hi - lo > 1e-3 * hi; ++it) {
+    // The chord's zero is safe when g(lo) > 0; from g(lo) = 0, halve the bracket instead.
+    const double c = g_lo > 0.0 ? lo + g_lo * (hi - lo) / (g_lo - g_hi) : 0.5 * (lo + hi);
+    const double gc = g(c);
+    if (gc >= 0.0) {
+      lo = c, g_lo = gc;
+    } else {
+      hi = c, g_hi = gc;
+    }
+    const double d = dg(hi);
+    if (d < 0.0) {
+      const double nw = hi - g_hi / d;  // Newton from the right: still an overshoot
+      if (nw > lo && nw < hi) hi = nw, g_hi = g(hi);
+    }
+    if (g_hi >= 0.0) return hi;
+  }
+  return lo;
+}
+
+}  // namespace
 
 Flight::Flight(const DieModel& model, const RigidState& s)
     : model_(&model),
@@ -111,7 +160,7 @@ ContactSearch Flight::next_contact(double t_limit) const {
   // Near a contact it converges quadratically (like Newton's method from the safe side).
   constexpr int kMaxIterations = 100000;
   const double min_step = 1e-15;
-  const int n = model_->vertex_count();
+  const int n = model_->curved() ? 0 : model_->vertex_count();  // a cylinder has rims, not corners
   const double rounding = model_->rounding;
   // The corners as a structure of arrays (padded to an even count), for corner_pass.
   const bool soa = n <= kSoaCorners;
@@ -147,6 +196,33 @@ ContactSearch Flight::next_contact(double t_limit) const {
     double numerator = std::numeric_limits<double>::infinity();
     int touching = -1;
     double touching_z = std::numeric_limits<double>::infinity();
+    double rim_step = std::numeric_limits<double>::infinity();  // a cylinder: its rims' safe step
+    if (model_->curved()) {
+      // Each rim circle: its lowest point in closed form; the rim touches when that point is on
+      // the floor and its material point moves down (feature 3 k: the rim's lowest point).
+      const Rims& rim = model_->rims;
+      const Vec3 K = R * rim.axis, e1 = R * rim.perp, e2 = K.cross(e1);
+      const Vec3 o = R * rim.centre;
+      for (int k = 0; k < 2; ++k) {
+        const Vec3 c = o + (k == 0 ? rim.half : -rim.half) * K;
+        const double a0 = zc + c.z() - rounding;
+        const double a1 = vz + (w.x() * c.y() - w.y() * c.x());
+        const Eigen::Vector2d p(e1.z(), e2.z());
+        const Eigen::Vector2d q(w.x() * e1.y() - w.y() * e1.x(), w.x() * e2.y() - w.y() * e2.x());
+        const double pn = p.norm();
+        const double z = a0 - rim.radius * pn;
+        // The lowest point's velocity (a flat rim: every point is lowest, take the fastest down).
+        const double zdot = pn > 1e-12 ? a1 - rim.radius * p.dot(q) / pn : a1 - rim.radius * q.norm();
+        if (z <= contact_tol_ && zdot < 0.0) {
+          if (z < touching_z) {
+            touching = 3 * k;
+            touching_z = z;
+          }
+          continue;
+        }
+        rim_step = std::min(rim_step, rim_safe_step(a0, a1, p, q, rim.radius, A));
+      }
+    }
     if (soa) {
       const CornerPass pass{{R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)},
                             zc, vz, w.x(), w.y(), rounding, 2.0 * A};
@@ -184,7 +260,7 @@ ContactSearch Flight::next_contact(double t_limit) const {
       out.at = state_with(t, R, w);
       return out;
     }
-    t += std::max(numerator / A, min_step * (1.0 + t));
+    t += std::max(std::min(numerator / A, rim_step), min_step * (1.0 + t));
   }
   out.outcome = ContactSearch::Outcome::IterationLimit;
   out.t = t;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "sim/body/die_model.hpp"
+#include "sim/body/rim.hpp"
 #include "sim/math.hpp"
 #include "sim/dynamics/torque_free.hpp"
 
@@ -50,8 +51,10 @@ class Flight {
 };
 
 // Where corner v touches a floor below it, relative to the COM (world): the lowest point of the
-// corner's ball, `rounding` below the corner (the corner itself for a sharp die).
+// corner's ball, `rounding` below the corner (the corner itself for a sharp die). A cylinder's
+// feature v: a point of a rim circle (sim/body/rim.hpp).
 inline Vec3 contact_point(const DieModel& m, const Mat3& R, int v) {
+  if (m.curved()) return rim_point(m, R, v);
   Vec3 r = R * m.vertices[static_cast<std::size_t>(v)];
   r.z() -= m.rounding;
   return r;
@@ -59,6 +62,7 @@ inline Vec3 contact_point(const DieModel& m, const Mat3& R, int v) {
 
 // Height above the floor of corner v's lowest point.
 inline double corner_height(const DieModel& m, const RigidState& s, int v) {
+  if (m.curved()) return s.position.z() + rim_point(m, s.R, v).z();
   return s.position.z() + s.R.row(2).dot(m.vertices[static_cast<std::size_t>(v)]) - m.rounding;
 }
 

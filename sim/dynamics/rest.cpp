@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "sim/dynamics/rim_rest.hpp"
+
 namespace dicesim {
 namespace {
 
@@ -200,6 +202,7 @@ void compute_rest_geometry(DieModel& m) {
 }
 
 int quasi_static_down_face(const DieModel& m, const Mat3& R, double tiebreak) {
+  if (m.curved()) return rim_quasi_static_down(m, R, tiebreak);
   int p = 0;
   double low = kInf;
   const int nv = m.vertex_count();
@@ -220,6 +223,7 @@ int roll_from_face(const DieModel& m, int f, double tiebreak) {
 }
 
 int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) {
+  if (m.curved()) return rim_rest_face_down(m, s, tiebreak);
   const Vec3 wb = s.R.transpose() * s.omega;
   const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
   const double mg = m.mass * m.gravity;

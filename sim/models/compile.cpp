@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "sim/body/body.hpp"
+#include "sim/body/rim.hpp"
+#include "sim/dynamics/rim_rest.hpp"
 #include "sim/models/fidelity_auto.hpp"
 #include "sim/dynamics/rest.hpp"
 #include "sim/scene/scene_error.hpp"
@@ -102,6 +104,91 @@ void build_outcomes(DieModel& m) {
   }
 }
 
+// Settings, fidelity, and the check that the die starts above the floor (every shape).
+void finish_model(DieModel& m, const SceneDef& scene, const std::string& origin) {
+  m.gravity = scene.sim.gravity;
+  m.step = scene.sim.step;
+  m.contact_step = scene.sim.contact_step;
+  m.stop_speed = scene.sim.stop_speed;
+  m.max_bounces = scene.sim.max_bounces;
+  m.max_time = scene.sim.max_time;
+  m.throw_ = scene.throw_;
+  m.catch_end = scene.sim.end == EndKind::Catch;
+  resolve_fidelity(scene, m);
+  if (m.catch_end)
+    m.fidelity_reason += "; sim.end = \"catch\": the die flies untouched to the catch (no floor), so no fidelity's contact model plays a part";
+
+  // The die must start above the floor. With a random orientation any corner may point down, so
+  // the mean COM height must clear the bounding sphere; with a fixed one, the lowest corner.
+  const NormalScalar& h = scene.throw_.height;
+  if (m.catch_end) {
+    // Caught in the hand: the floor plays no part.
+  } else if (scene.throw_.orientation.kind == OrientationKind::Fixed) {
+    const Vec3 e = scene.throw_.orientation.euler_deg * (kPi / 180.0);
+    const Mat3 R = euler_zxz(e.x(), e.y(), e.z()) * m.geo_to_body.transpose();
+    double depth = 0.0;
+    for (const Vec3& v : m.vertices) depth = std::max(depth, -(R * v).z() + m.rounding);
+    if (m.curved()) depth = -rim_lowest(m, R);
+    if (h.mean < depth - 1e-12 * m.bounding_radius)
+      throw SceneError(origin, "throw.height.mean", fmt(h.mean),
+                       "the die starts below the floor: in this orientation the COM must be at least " +
+                           fmt(depth) + " m above it");
+  } else if (h.mean < m.bounding_radius) {
+    throw SceneError(origin, "throw.height.mean", fmt(h.mean),
+                     "the die could start below the floor: with a random orientation the COM must be at "
+                     "least the bounding radius " + fmt(m.bounding_radius) + " m above it");
+  }
+}
+
+// A cylinder: principal frame, rim circles, three "faces" (heads, tails, side), rest geometry.
+DieModel compile_cylinder(const Body& body, const SceneDef& scene, const std::string& origin) {
+  if (body.face_labels.size() != 3 || body.vertex_restitution.size() != kRimFeatures ||
+      body.vertex_friction.size() != kRimFeatures || body.vertex_rolling.size() != kRimFeatures)
+    throw SceneError(origin, "die.shape", body.kind, "the body is incomplete (labels or materials missing)");
+  DieModel m;
+  m.name = scene.name;
+  m.kind = body.kind;
+  m.read_down = false;
+  m.rounding = body.cylinder.rounding;
+  m.mass_geometric = body.mass;
+  const MassProperties& mp = m.mass_geometric;
+  m.mass = mp.mass;
+  m.principal_moments = mp.principal_moments;
+  m.geo_to_body = mp.principal_axes.transpose();
+  m.symmetric_top = is_symmetric_top(m.principal_moments);
+
+  Rims& rim = m.rims;
+  rim.on = true;
+  rim.centre = m.geo_to_body * (-mp.com);
+  rim.axis = (m.geo_to_body * Vec3::UnitZ()).normalized();
+  rim.perp = (m.geo_to_body * Vec3::UnitX()).normalized();
+  rim.radius = body.cylinder.core_radius();
+  rim.half = body.cylinder.core_half();
+  for (int f = 0; f < kRimFeatures; ++f) {
+    m.vertex_restitution.push_back(scene.floor.restitution ? *scene.floor.restitution : body.vertex_restitution[f]);
+    m.vertex_friction.push_back(body.vertex_friction[f]);
+    m.vertex_rolling.push_back(body.vertex_rolling[f]);
+  }
+  // The farthest body point from the COM: on a rim circle (plus the rounding).
+  const Vec3 o_perp = rim.centre - rim.centre.dot(rim.axis) * rim.axis;
+  double reach = 0.0;
+  for (double sgn : {1.0, -1.0}) {
+    const double par = rim.centre.dot(rim.axis) + sgn * rim.half;
+    reach = std::max(reach, std::hypot(par, o_perp.norm() + rim.radius));
+  }
+  m.bounding_radius = reach + m.rounding;
+
+  m.face_normals = {rim.axis, -rim.axis, Vec3::Zero()};
+  m.face_labels = body.face_labels;
+  m.face_begin.assign(4, 0);  // no corner loops: the faces are discs and a curved side
+  build_outcomes(m);
+  m.face_result = {1, 0, 2};  // heads face down shows tails, tails face down heads, the side edge
+  compute_rim_rest_geometry(m);
+  m.max_friction = *std::max_element(m.vertex_friction.begin(), m.vertex_friction.end());
+  finish_model(m, scene, origin);
+  return m;
+}
+
 }  // namespace
 
 DieModel compile(const SceneDef& scene, const std::string& origin) {
@@ -109,6 +196,7 @@ DieModel compile(const SceneDef& scene, const std::string& origin) {
 }
 
 DieModel compile_body(const Body& body, const SceneDef& scene, const std::string& origin) {
+  if (body.kind == "cylinder") return compile_cylinder(body, scene, origin);
   const ConvexShape& shape = body.shape;
   const std::size_t nv = shape.vertices.size(), nf = shape.faces.size();
   if (nv < 4 || nf < 4 || shape.normals.size() != nf || body.face_labels.size() != nf ||
@@ -149,32 +237,7 @@ DieModel compile_body(const Body& body, const SceneDef& scene, const std::string
   compute_rest_geometry(m);
   m.max_friction = *std::max_element(m.vertex_friction.begin(), m.vertex_friction.end());
 
-  m.gravity = scene.sim.gravity;
-  m.step = scene.sim.step;
-  m.contact_step = scene.sim.contact_step;
-  m.stop_speed = scene.sim.stop_speed;
-  m.max_bounces = scene.sim.max_bounces;
-  m.max_time = scene.sim.max_time;
-  m.throw_ = scene.throw_;
-  resolve_fidelity(scene, m);
-
-  // The die must start above the floor. With a random orientation any corner may point down, so
-  // the mean COM height must clear the bounding sphere; with a fixed one, the lowest corner.
-  const NormalScalar& h = scene.throw_.height;
-  if (scene.throw_.orientation.kind == OrientationKind::Fixed) {
-    const Vec3 e = scene.throw_.orientation.euler_deg * (kPi / 180.0);
-    const Mat3 R = euler_zxz(e.x(), e.y(), e.z()) * m.geo_to_body.transpose();
-    double depth = 0.0;
-    for (const Vec3& v : m.vertices) depth = std::max(depth, -(R * v).z() + m.rounding);
-    if (h.mean < depth - 1e-12 * m.bounding_radius)
-      throw SceneError(origin, "throw.height.mean", fmt(h.mean),
-                       "the die starts below the floor: in this orientation the COM must be at least " +
-                           fmt(depth) + " m above it");
-  } else if (h.mean < m.bounding_radius) {
-    throw SceneError(origin, "throw.height.mean", fmt(h.mean),
-                     "the die could start below the floor: with a random orientation the COM must be at "
-                     "least the bounding radius " + fmt(m.bounding_radius) + " m above it");
-  }
+  finish_model(m, scene, origin);
   return m;
 }
 

@@ -65,7 +65,19 @@ InitialState draw_initial_state(const ThrowDef& thr, std::uint64_t seed, std::ui
       s.omega = axis.normalized() * draw(rng, thr.spin.magnitude);
       break;
     }
+    case SpinKind::BodyAxis: {
+      // A thumb's flip: the angular velocity at angle tilt from a body axis, azimuth uniform,
+      // given in the die's geometric frame and carried to the world by the orientation.
+      const Vec3 a = thr.spin.axis.normalized();
+      const Vec3 e1 = a.unitOrthogonal(), e2 = a.cross(e1);
+      const double tilt = draw(rng, thr.spin.tilt_deg) * (kPi / 180.0);
+      const double az = 2.0 * kPi * rng.uniform();
+      const Vec3 dir = std::cos(tilt) * a + std::sin(tilt) * (std::cos(az) * e1 + std::sin(az) * e2);
+      s.omega = s.orientation * dir * draw(rng, thr.spin.magnitude);
+      break;
+    }
   }
+  if (thr.catch_time) s.catch_time = draw(rng, *thr.catch_time);
   return s;
 }
 

@@ -45,7 +45,9 @@ namespace {
 
 bool starts_valid(const DieModel& m, const RigidState& s) {
   if (!s.position.allFinite() || !s.velocity.allFinite() || !s.omega.allFinite() || !s.R.allFinite()) return false;
+  if (m.catch_end) return true;  // caught in the hand: the floor plays no part
   const double tol = 1e-9 * m.bounding_radius;
+  if (m.curved()) return s.position.z() + rim_lowest(m, s.R) >= -tol;
   for (const Vec3& v : m.vertices)
     if (s.position.z() + s.R.row(2).dot(v) - m.rounding < -tol) return false;
   return true;
@@ -125,9 +127,22 @@ double tiebreak_of(const InitialState& init) {
   return static_cast<double>(h >> 11) * 0x1.0p-53;
 }
 
+// sim.end = "catch": exact torque-free flight to the catch time, then the face most nearly up
+// (never the side). The COM's path does not matter: the hand is wherever the die is.
+TossResult run_catch(const DieModel& m, const RigidState& s, double t) {
+  TossResult r;
+  if (!(t > 0.0) || !std::isfinite(t)) return r;  // Invalid (a catch time <= 0: 1e-9 odds by the scene check)
+  const TorqueFreeRotation rot(m.principal_moments, s.R, world_inertia(m, s.R) * s.omega);
+  set_result_face(m, caught_face_index(m, rot.orientation(t)), r);
+  r.status = TossStatus::Settled;
+  r.t_end = t;
+  return r;
+}
+
 TossResult run(const DieModel& m, const InitialState& init, double tiebreak, TossProbe* probe) {
   const RigidState s = to_body_state(m, init);
   if (!starts_valid(m, s)) return TossResult{};  // status Invalid
+  if (m.catch_end) return run_catch(m, s, init.catch_time);
   switch (m.fidelity) {
     case Fidelity::Paper: return run_paper(m, s, probe);
     case Fidelity::Static: {

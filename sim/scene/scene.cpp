@@ -148,12 +148,18 @@ constexpr Names<OrientationKind, 3> kOrientationKinds{{
     {"fixed", OrientationKind::Fixed},
 }};
 // "fixed" spin is the normal kind with sd 0: the sampler needs no extra case.
-constexpr Names<SpinKind, 4> kSpinKinds{{
+constexpr Names<SpinKind, 5> kSpinKinds{{
     {"normal", SpinKind::Normal},
     {"random-axis", SpinKind::RandomAxis},
     {"octant-axis", SpinKind::OctantAxis},
+    {"body-axis", SpinKind::BodyAxis},
     {"fixed", SpinKind::Normal},
 }};
+constexpr Names<EndKind, 2> kEndKinds{{{"floor", EndKind::Floor}, {"catch", EndKind::Catch}}};
+constexpr Range kRollingResistance{.lo = 0, .hi = 0.1, .unit = "m"};
+constexpr Range kCatchTime{.lo = 0, .hi = 1e3, .lo_open = true, .unit = "s"};
+constexpr Range kCatchTimeSd{.lo = 0, .hi = 1e3, .unit = "s"};
+constexpr Range kTiltSd{.lo = 0, .hi = 180, .unit = "deg"};
 constexpr Names<bool, 2> kHeightKinds{{{"normal", false}, {"fixed", true}}};  // value: is fixed
 
 // ---- Reading one table -----------------------------------------------------------------------
@@ -297,6 +303,7 @@ void read_materials(Reader all, std::map<std::string, MaterialDef>& out) {
     def.density = m.number("density", kDensity, def.density);
     def.restitution = m.number("restitution", kRestitution, def.restitution);
     def.friction = m.number("friction", kFriction, def.friction);
+    def.rolling_resistance = m.number("rolling_resistance", kRollingResistance, def.rolling_resistance);
     m.finish();
     out[std::string(name.str())] = def;
   }
@@ -362,12 +369,15 @@ void read_die(Reader die, const std::map<std::string, MaterialDef>& materials, D
   };
   only_for("size", kind == ShapeKind::Box || is_preset(kind), "shape = \"box\" and the presets d4..d20");
   only_for("sides", kind == ShapeKind::Prism, "shape = \"prism\"");
-  only_for("radius", kind == ShapeKind::Prism, "shape = \"prism\"");
+  only_for("radius", kind == ShapeKind::Prism || kind == ShapeKind::Cylinder, "shape = \"prism\" and \"cylinder\"");
+  only_for("height", kind == ShapeKind::Cylinder, "shape = \"cylinder\"");
   only_for("length", kind == ShapeKind::Prism, "shape = \"prism\"");
   only_for("vertices", kind == ShapeKind::Hull, "shape = \"hull\"");
   only_for("mesh", kind == ShapeKind::Mesh, "shape = \"mesh\"");
   only_for("scale", kind == ShapeKind::Hull || kind == ShapeKind::Mesh, "shape = \"hull\" and \"mesh\"");
-  only_for("faces", kind == ShapeKind::Box || kind == ShapeKind::D6, "shape = \"box\" and \"d6\"; use [[die.labels]]");
+  only_for("faces", kind == ShapeKind::Box || kind == ShapeKind::D6 || kind == ShapeKind::Cylinder,
+           "shape = \"box\", \"d6\" and \"cylinder\"; use [[die.labels]]");
+  only_for("labels", kind != ShapeKind::Cylinder, "polyhedral shapes; a cylinder's labels are [die.faces] heads, tails, edge");
   only_for("rounding", kind != ShapeKind::Mesh, "every shape but \"mesh\" (round the mesh itself)");
 
   if (kind == ShapeKind::Box) {
@@ -383,6 +393,9 @@ void read_die(Reader die, const std::map<std::string, MaterialDef>& materials, D
     def.sides = die.integer("sides", 3, 1000, def.sides);
     def.radius = die.number("radius", kEdge, def.radius);
     def.length = die.number("length", kEdge, def.length);
+  } else if (kind == ShapeKind::Cylinder) {
+    def.radius = die.number("radius", kEdge, def.radius);
+    def.height = die.number("height", kEdge, def.height);
   } else if (kind == ShapeKind::Hull) {
     const toml::node* n = die.get("vertices");
     if (!n) die.fail_missing("vertices", "an array of at least 4 points [x, y, z] (m), not all in one plane");
@@ -403,6 +416,9 @@ void read_die(Reader die, const std::map<std::string, MaterialDef>& materials, D
   }
   def.scale = die.number("scale", kScale, def.scale);
   def.rounding = die.number("rounding", kRounding, def.rounding);
+  if (kind == ShapeKind::Cylinder && def.rounding >= std::min(def.radius, 0.5 * def.height))
+    die.fail(die.get("rounding"), die.path_of("rounding"),
+             "must be a number >= 0 and below min(radius, height/2) = " + num_text(std::min(def.radius, 0.5 * def.height)) + " m");
   if (die.get("read")) def.read_down = die.choice("read", kReadSides, false).second;
 
   def.base_material = material_ref(die, materials);
@@ -435,6 +451,14 @@ void read_die(Reader die, const std::map<std::string, MaterialDef>& materials, D
   }
 
   Reader faces = die.sub("faces");
+  if (kind == ShapeKind::Cylinder) {
+    // Heads, tails, edge: any integers of the wire's range; equal labels group outcomes.
+    for (std::size_t i = 0; i < 3; ++i)
+      def.cylinder_labels[i] = faces.integer(kCylinderOutcomeNames[i], 0, 999, def.cylinder_labels[i]);
+    faces.finish();
+    die.finish();
+    return;
+  }
   for (std::size_t i = 0; i < 6; ++i) def.face_labels[i] = faces.integer(kFaceDirNames[i], 1, 99, def.face_labels[i]);
   for (std::size_t i = 0; i < 6; ++i)
     for (std::size_t j = i + 1; j < 6; ++j) {
@@ -478,7 +502,31 @@ void read_throw(Reader th, ThrowDef& def) {
     def.spin.magnitude.mean = spin.number("mean", kSpin, def.spin.magnitude.mean);
     def.spin.magnitude.sd = spin.number("sd", kSpinSd, def.spin.magnitude.sd);
   }
+  if (kind == SpinKind::BodyAxis) {
+    const toml::node* axis = spin.get("axis");
+    def.spin.axis = spin.vec3("axis", kAnyNumber, def.spin.axis, false);
+    if (def.spin.axis.isZero(0.0))
+      spin.fail(axis, spin.path_of("axis"), "must be an array of 3 numbers, not all 0: the spin axis in the die's frame");
+    def.spin.tilt_deg.mean = spin.number("tilt_deg", kAngle, def.spin.tilt_deg.mean);
+    def.spin.tilt_deg.sd = spin.number("tilt_sd_deg", kTiltSd, def.spin.tilt_deg.sd);
+  }
   spin.finish();
+
+  if (th.get("catch_time")) {
+    Reader ct = th.sub("catch_time");
+    const bool fixed = ct.choice("kind", kHeightKinds, false).second;
+    if (!ct.get("mean")) ct.fail_missing("mean", "a number" + kCatchTime.text());
+    NormalScalar c;
+    c.mean = ct.number("mean", kCatchTime, 0.5);
+    c.sd = fixed ? 0.0 : ct.number("sd", kCatchTimeSd, 0.0);
+    if (fixed && ct.get("sd")) ct.fail(ct.get("sd"), ct.path_of("sd"), "does not apply to kind = \"fixed\"");
+    // A normal has unbounded support; 6 sd below the mean (probability 1e-9) must still be after release.
+    if (c.mean - 6.0 * c.sd <= 0.0)
+      ct.fail(ct.get("sd"), ct.path_of("sd"),
+              "the catch time could be negative: sd must be below mean / 6 = " + num_text(c.mean / 6.0) + " s");
+    ct.finish();
+    def.catch_time = c;
+  }
   th.finish();
 }
 
@@ -499,6 +547,7 @@ void read_sim(Reader sim, SimDef& def) {
   def.max_time = sim.number("max_time", kMaxTime, def.max_time);
   def.step = sim.number("step", kStep, def.step);
   def.contact_step = sim.number("contact_step", kStep, def.contact_step);
+  if (sim.get("end")) def.end = sim.choice("end", kEndKinds, def.end).second;
   sim.finish();
 }
 
@@ -513,6 +562,14 @@ SceneDef build(const toml::table& tree, const std::string& origin, const std::st
   read_throw(top.sub("throw"), s.throw_);
   read_floor(top.sub("floor"), s.floor);
   read_sim(top.sub("sim"), s.sim);
+  if (s.sim.end == EndKind::Catch && !s.throw_.catch_time) {
+    Reader sim = top.sub("sim");
+    sim.fail(sim.get("end"), "sim.end", "\"catch\" needs [throw.catch_time] (mean, sd in s: when the hand catches the die)");
+  }
+  if (s.sim.end == EndKind::Floor && s.throw_.catch_time) {
+    Reader th = top.sub("throw");
+    th.fail(th.get("catch_time"), "throw.catch_time", "applies only to sim.end = \"catch\"");
+  }
   top.finish();
   return s;
 }

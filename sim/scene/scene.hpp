@@ -17,6 +17,11 @@ struct MaterialDef {
   double density = 1000.0;    // kg/m^3, > 0
   double restitution = 0.5;   // [0, 1] against the floor
   double friction = 0.3;      // Coulomb coefficient against the floor, [0, 10]
+  // Rolling resistance (m): the floor's normal force N acts this far ahead of a rolling contact,
+  // a torque N * rolling_resistance against the roll. Used by curved dice (a cylinder) in
+  // `impulse` and `stepped`, so that a cylinder rolling on its side comes to rest. [0, 0.1].
+  // Default 3e-4 m: a coin rolling on hardwood slows by ~0.2 m/s^2 (an order of magnitude).
+  double rolling_resistance = 3e-4;
 };
 
 // Half-space {x : normal . x <= offset} in the die's geometric frame (m): origin at the centre for a
@@ -39,10 +44,15 @@ inline constexpr std::array<const char*, 6> kFaceDirNames = {"+x", "-x", "+y", "
 
 // The kinds of die (die.shape). Box is today's six-faced box; the presets are the regular solids
 // (d10: the pentagonal trapezohedron); prism: a regular n-gon prism; hull: the convex hull of
-// listed points; mesh: a closed Wavefront OBJ (contact on its hull, mass from the mesh itself).
-enum class ShapeKind { Box, D4, D6, D8, D10, D12, D20, Prism, Hull, Mesh };
-inline constexpr std::array<const char*, 10> kShapeNames = {"box", "d4",  "d6",    "d8",   "d10",
-                                                            "d12", "d20", "prism", "hull", "mesh"};
+// listed points; mesh: a closed Wavefront OBJ (contact on its hull, mass from the mesh itself);
+// cylinder: a right circular cylinder (a coin), its curved side exact (not a polytope).
+enum class ShapeKind { Box, D4, D6, D8, D10, D12, D20, Prism, Hull, Mesh, Cylinder };
+inline constexpr std::array<const char*, 11> kShapeNames = {"box", "d4",   "d6",   "d8",   "d10",     "d12",
+                                                            "d20", "prism", "hull", "mesh", "cylinder"};
+
+// A cylinder's outcomes, in this order everywhere: heads (+z face up), tails (-z face up), edge
+// (resting on the curved side).
+inline constexpr std::array<const char*, 3> kCylinderOutcomeNames = {"heads", "tails", "edge"};
 
 // [[die.labels]]: the face whose outward normal is nearest `normal` gets `label`.
 struct LabelDef {
@@ -56,7 +66,8 @@ struct DieDef {
   // (d4: from a face to the opposite vertex); the scene gives it as one number.
   Vec3 size = Vec3(0.03, 0.03, 0.03);
   int sides = 3;                       // prism: number of sides of the regular n-gon, >= 3
-  double radius = 0.01;                // prism: circumradius of the n-gon (m)
+  double radius = 0.01;                // prism: circumradius of the n-gon; cylinder: radius (m)
+  double height = 0.002;               // cylinder: thickness along z (m)
   double length = 0.05;                // prism: length along z (m)
   std::vector<Vec3> vertices;          // hull: the points whose convex hull is the die (m)
   std::string mesh;                    // mesh: the OBJ path as written in the scene
@@ -71,6 +82,8 @@ struct DieDef {
   // Box (and d6): label of the face whose outward normal is +x, -x, +y, -y, +z, -z (a standard die
   // by default: 1 up on +z, opposite faces sum to 7).
   std::array<int, 6> face_labels = {2, 5, 3, 4, 1, 6};
+  // Cylinder: labels of heads, tails, edge ([die.faces] heads/tails/edge), integers in [0, 999].
+  std::array<int, 3> cylinder_labels = {1, 2, 0};
 };
 
 enum class OrientationKind { Uniform, EulerUniform, Fixed };
@@ -95,19 +108,29 @@ enum class SpinKind {
   Normal,       // each world component ~ normal(mean_i, sd_i)
   RandomAxis,   // magnitude ~ normal(mean, sd) along an axis uniform on the sphere
   OctantAxis,   // magnitude ~ normal(mean, sd) along the seed's axis: components uniform [0,1], normalised
+  BodyAxis,     // a flipping thumb: magnitude ~ normal(mean, sd) at angle ~ normal(tilt, tilt_sd) from a
+                // body-frame axis, azimuth uniform (geometric frame of the die)
 };
 struct SpinDef {
   SpinKind kind = SpinKind::Normal;
   NormalVector components;   // kind == Normal (rad/s, world frame)
-  NormalScalar magnitude;    // kind == RandomAxis / OctantAxis (rad/s)
+  NormalScalar magnitude;    // kind == RandomAxis / OctantAxis / BodyAxis (rad/s)
+  Vec3 axis = Vec3::UnitX(); // kind == BodyAxis: in the die's geometric frame, not zero
+  NormalScalar tilt_deg;     // kind == BodyAxis: angle of the angular velocity from `axis` (deg)
 };
 
 struct ThrowDef {
   OrientationDef orientation;
   NormalScalar height{1.0, 0.2};                                      // COM height above floor (m)
   NormalVector velocity{Vec3::Zero(), Vec3::Constant(0.5)};           // COM velocity (m/s)
-  SpinDef spin{SpinKind::Normal, {Vec3::Zero(), Vec3::Constant(18.0)}, {}};
+  SpinDef spin{SpinKind::Normal, {Vec3::Zero(), Vec3::Constant(18.0)}, {}, Vec3::UnitX(), {}};
+  // sim.end = "catch": the time after release at which the die is caught (s), normal(mean, sd).
+  std::optional<NormalScalar> catch_time;
 };
+
+// How a toss ends: on the floor (the fidelity's dynamics), or caught in the hand in mid-flight
+// (exact flight only; the result is the face most nearly up at the catch, never `edge`).
+enum class EndKind { Floor, Catch };
 
 struct FloorDef {
   // When set, every contact uses this restitution instead of the die material's
@@ -124,6 +147,7 @@ struct SimDef {
   // Accuracy settings of the fidelity ladder (docs/fidelity.md measures what they cost and change).
   double step = 2e-4;           // s: `stepped`'s fixed time step (the reference)
   double contact_step = 1e-3;   // s: `impulse`'s time step while the die rolls/slides in sustained contact
+  EndKind end = EndKind::Floor; // "floor" or "catch" (needs [throw.catch_time])
 };
 
 struct SceneDef {

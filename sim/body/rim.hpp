@@ -1,0 +1,47 @@
+// A cylinder's contact features at one orientation: the lowest point of each rim circle, in
+// closed form, and the two points 120 deg either side of it (sim/body/die_model.hpp, Rims). The
+// exact curved side: a cylinder on its side touches with both rims' lowest points (the ends of
+// its contact line), on a rim with one, flat on a face with that rim's tripod.
+#pragma once
+
+#include <cmath>
+
+#include "sim/body/die_model.hpp"
+
+namespace dicesim {
+
+// Unit vector in rim plane (perpendicular to the world axis K) pointing most nearly down; a fixed
+// body direction when the axis is vertical (then every rim point is equally low).
+inline Vec3 rim_down(const DieModel& m, const Mat3& R, const Vec3& K) {
+  Vec3 u(K.z() * K.x(), K.z() * K.y(), K.z() * K.z() - 1.0);  // -e_z minus its component along K
+  const double n = u.norm();
+  if (n < 1e-12) return R * m.rims.perp;
+  return u / n;
+}
+
+// Feature v's contact point relative to the COM (world), the rounding included.
+inline Vec3 rim_point(const DieModel& m, const Mat3& R, int v) {
+  const Vec3 K = R * m.rims.axis;
+  const Vec3 c = R * m.rims.centre + ((v < 3) ? m.rims.half : -m.rims.half) * K;
+  const Vec3 u = rim_down(m, R, K);
+  const int j = v % 3;
+  Vec3 p;
+  if (j == 0) {
+    p = c + m.rims.radius * u;
+  } else {
+    constexpr double kCos = -0.5, kSin = 0.86602540378443864676;
+    p = c + m.rims.radius * (kCos * u + (j == 1 ? kSin : -kSin) * K.cross(u));
+  }
+  p.z() -= m.rounding;
+  return p;
+}
+
+// Height of the die's lowest point relative to its COM (world z), rounding included.
+inline double rim_lowest(const DieModel& m, const Mat3& R) {
+  const Vec3 K = R * m.rims.axis;
+  const double cz = R.row(2).dot(m.rims.centre);
+  const double drop = m.rims.radius * std::sqrt(std::max(0.0, 1.0 - K.z() * K.z()));
+  return cz - m.rims.half * std::abs(K.z()) - drop - m.rounding;
+}
+
+}  // namespace dicesim

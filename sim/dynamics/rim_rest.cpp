@@ -1,0 +1,145 @@
+#include "sim/dynamics/rim_rest.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "sim/dynamics/contact.hpp"
+
+namespace dicesim {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Distance from the COM (origin) to the nearest point of the circle centre c, axis k, radius a.
+double circle_distance(const Vec3& c, const Vec3& k, double a) {
+  const Vec3 w = -c;
+  const double par = w.dot(k);
+  const double perp = (w - par * k).norm();
+  return std::sqrt(par * par + (perp - a) * (perp - a));
+}
+
+}  // namespace
+
+void compute_rim_rest_geometry(DieModel& m) {
+  const Rims& rim = m.rims;
+  const Vec3& k = rim.axis;
+  const Vec3& o = rim.centre;
+  const double ok = o.dot(k), o_perp = (o - ok * k).norm();
+  const double r = m.rounding;
+  m.face_height = {ok + rim.half + r, -ok + rim.half + r, rim.radius - o_perp + r};
+  m.face_hold = {rim.radius - o_perp, rim.radius - o_perp, rim.half - std::abs(ok)};
+  const double e0 = circle_distance(o + rim.half * k, k, rim.radius) + r;
+  const double e1 = circle_distance(o - rim.half * k, k, rim.radius) + r;
+  m.face_escape = {e0, e1, std::min(e0, e1)};
+  m.face_tip_ratio.resize(3);
+  for (int f = 0; f < 3; ++f) m.face_tip_ratio[f] = m.face_hold[f] / m.face_height[f];
+  const Mat3 I = m.principal_moments.asDiagonal();
+  m.face_gyro = {k.cross(I * k).norm(), k.cross(I * k).norm(), 0.0};
+  m.face_area = {kPi * rim.radius * rim.radius, kPi * rim.radius * rim.radius, 2.0 * kPi * rim.radius * 2.0 * rim.half};
+  m.max_escape = 0.0;
+  for (int f = 0; f < 3; ++f)
+    if (m.face_hold[f] >= 0.0) m.max_escape = std::max(m.max_escape, m.face_escape[f]);
+}
+
+int rim_quasi_static_down(const DieModel& m, const Mat3& R, double tiebreak) {
+  const Rims& rim = m.rims;
+  const Vec3& k = rim.axis;
+  const Vec3& o = rim.centre;
+  const bool valley = std::abs(o.dot(k)) < rim.half;
+  const bool face_stable = (o - o.dot(k) * k).norm() < rim.radius;
+  constexpr double kStep = 1e-3;  // rad
+  Vec3 d = R.transpose() * Vec3(0.0, 0.0, -1.0);
+  const double o_perp = (o - o.dot(k) * k).norm();
+  if (o_perp <= 1e-12 * rim.radius && valley) {
+    // COM on the axis: the roll stays in the plane of the axis and the down direction; at angle
+    // theta from the face normal sigma = (s o.k + b) cos theta + a sin theta, so the die falls
+    // onto the face iff a cos theta > (s o.k + b) sin theta, else onto its side.
+    const double dk = d.dot(k), s = dk >= 0.0 ? 1.0 : -1.0;
+    const double lhs = rim.radius * std::abs(dk), rhs = (s * o.dot(k) + rim.half) * (d - dk * k).norm();
+    const int face = dk >= 0.0 ? 0 : 1;
+    if (lhs == rhs) return tiebreak < 0.5 ? face : 2;
+    return lhs > rhs ? face : 2;
+  }
+  for (int it = 0; it < 20000; ++it) {
+    const double dk = d.dot(k);
+    const Vec3 dp = d - dk * k;
+    const double np = dp.norm();
+    if (np < kStep && face_stable) return dk > 0.0 ? 0 : 1;
+    if (std::abs(dk) < 1e-15 && valley) return 2;  // exactly on the side
+    Vec3 g = o + (dk > 0.0 ? rim.half : -rim.half) * k;
+    if (np > 0.0) g += rim.radius * dp / np;
+    Vec3 gt = g - g.dot(d) * d;
+    if (gt.norm() <= 1e-12 * rim.radius) {  // balanced exactly: the toss decides the way
+      const Vec3 u = d.unitOrthogonal(), v = d.cross(u);
+      const double a = 2.0 * kPi * tiebreak;
+      gt = std::cos(a) * u + std::sin(a) * v;
+    }
+    const Vec3 next = (d - kStep * gt.normalized()).normalized();
+    if ((next.dot(k) > 0.0) != (dk > 0.0) && valley) return 2;  // reached the side's valley
+    d = next;
+  }
+  return -1;
+}
+
+int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) {
+  const Vec3 wb = s.R.transpose() * s.omega;
+  const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
+  const double mg = m.mass * m.gravity;
+  if (ke + mg * s.position.z() >= mg * m.max_escape) return -1;
+  const double low = s.position.z() + rim_lowest(m, s.R);
+  const double energy = ke + mg * (s.position.z() + std::max(0.0, -low));
+  const int basin = rim_quasi_static_down(m, s.R, tiebreak);
+  if (basin >= 0 && energy < mg * m.face_escape[static_cast<std::size_t>(basin)] * (1.0 - 1e-9)) return basin;
+
+  // Lying flat on a face, sliding or spinning but not rocking (as a polytope's face, rest.hpp):
+  // the face's tripod on the floor with vanishing normal velocity, friction too weak to tip it
+  // (mu below face_tip_ratio), and the spin about the vertical within what gravity holds against
+  // the gyroscopic torque w^2 |n x I n| (0 for a symmetric coin). Such a coin cannot turn over.
+  const double kz = s.R.row(2).dot(m.rims.axis);
+  if (std::abs(kz) < 0.999) return -1;
+  const int down = kz < 0.0 ? 0 : 1;  // face 0 (heads face) down when the axis points down
+  const std::size_t di = static_cast<std::size_t>(down);
+  const double flat_tol = 1e-6 * m.bounding_radius;
+  const double v_tol = 1e-3 * std::sqrt(m.gravity * m.bounding_radius);
+  const double spin = s.omega.z();
+  if (!(m.face_hold[di] >= 0.0 && m.max_friction < 0.999 * m.face_tip_ratio[di] &&
+        spin * spin * m.face_gyro[di] < 0.999 * mg * m.face_hold[di]))
+    return -1;
+  for (int j = 0; j < 3; ++j) {
+    const Vec3 r = rim_point(m, s.R, 3 * down + j);
+    if (s.position.z() + r.z() - std::min(low, 0.0) > flat_tol) return -1;
+    if (std::abs((s.velocity + s.omega.cross(r)).z()) > v_tol) return -1;
+  }
+  return down;
+}
+
+double rim_lowest_excluding(const DieModel& m, const Mat3& R, const ContactSet& c) {
+  double low = kInf;
+  int j = 0;  // c.vertex is ascending
+  for (int i = 0; i < kRimFeatures; ++i) {
+    if (j < c.n && c.vertex[j] == i) {
+      ++j;
+      continue;
+    }
+    low = std::min(low, rim_point(m, R, i).z());
+  }
+  return low;
+}
+
+void apply_rolling_resistance(const DieModel& m, RigidState& s, const ContactSet& c, double normal_impulse) {
+  if (c.n == 0 || !(normal_impulse > 0.0)) return;
+  const Vec3 wh(s.omega.x(), s.omega.y(), 0.0);
+  const double w = wh.norm();
+  if (w <= 0.0) return;
+  double delta = 0.0;
+  for (int i = 0; i < c.n; ++i) delta += m.vertex_rolling[static_cast<std::size_t>(c.vertex[i])];
+  delta /= c.n;
+  if (delta <= 0.0) return;
+  const Vec3 u = wh / w;
+  const Vec3 inv_u = s.R * (s.R.transpose() * u).cwiseQuotient(m.principal_moments);  // I_w^-1 u
+  const double lam = std::min(delta * normal_impulse, w / u.dot(inv_u));
+  s.omega -= lam * inv_u;
+}
+
+}  // namespace dicesim

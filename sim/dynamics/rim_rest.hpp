@@ -1,0 +1,41 @@
+// Coming to rest on a curved die (a cylinder): its resting geometry, the quasi-static roll, the
+// "outcome settled" rule, and rolling resistance. Faces of a cylinder model: 0 = the heads face
+// (normal +axis), 1 = the tails face, 2 = the curved side; "face f down" = lying on it.
+//
+// The COM height of the cylinder standing on the floor with body-frame down direction d is its
+// support function  sigma(d) = o.d + b |d.k| + a |d - (d.k) k| + r  (o: geometric centre from the
+// COM, k: axis, a, b: core rim radius and half-height, r: rounding). Faces are its minima at
+// d = +-k (stable when the COM's foot is inside the face, |o_perp| < a); the side is the valley
+// d.k = 0 (stable when |o.k| < b); the saddles between them are the die balanced on a rim point
+// with the COM above it, at the distance from the COM to the nearest point of that rim circle.
+// No impact or contact solve creates energy, so E < m g (that saddle's height) in a basin means
+// the die ends in that basin: an edge-rolling cylinder is settled `edge` as soon as it can no
+// longer tip onto a face, without following its roll to a stop.
+#pragma once
+
+#include "sim/body/die_model.hpp"
+#include "sim/dynamics/flight.hpp"
+#include "sim/dynamics/friction_impact.hpp"
+
+namespace dicesim {
+
+// Fills face_height, face_hold, face_escape, face_tip_ratio, face_gyro, face_area, max_escape.
+void compute_rim_rest_geometry(DieModel& m);
+
+// The quasi-static roll from orientation R: steepest descent of sigma on the sphere of down
+// directions, in steps of 1e-3 rad (exact for an axisymmetric COM: the first step's side of the
+// rim balance decides). Returns the face down (0, 1, 2) or -1 if the step guard ran out.
+int rim_quasi_static_down(const DieModel& m, const Mat3& R, double tiebreak);
+
+// The face the die must come to rest on (energy below its basin's saddle), or -1.
+int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak);
+
+// Lowest contact-feature height relative to the COM (world z) over features not in c.
+double rim_lowest_excluding(const DieModel& m, const Mat3& R, const ContactSet& c);
+
+// Rolling resistance for one step with contact set c that carried normal impulse `normal_impulse`:
+// an angular impulse rolling_resistance * normal_impulse against the horizontal angular velocity
+// (the roll), capped so that it stops the roll at most (never reverses it: energy only falls).
+void apply_rolling_resistance(const DieModel& m, RigidState& s, const ContactSet& c, double normal_impulse);
+
+}  // namespace dicesim
