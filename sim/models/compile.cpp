@@ -140,22 +140,28 @@ void finish_model(DieModel& m, const SceneDef& scene, const std::string& origin)
   }
 }
 
+// What every shape starts from: its name, kind, mass and principal frame.
+DieModel start_model(const Body& body, const SceneDef& scene) {
+  DieModel m;
+  m.name = scene.name;
+  m.kind = body.kind;
+  m.mass_geometric = body.mass;
+  m.mass = body.mass.mass;
+  m.principal_moments = body.mass.principal_moments;
+  m.geo_to_body = body.mass.principal_axes.transpose();
+  m.symmetric_top = is_symmetric_top(m.principal_moments);
+  return m;
+}
+
 // A cylinder: principal frame, rim circles, three "faces" (heads, tails, side), rest geometry.
 DieModel compile_cylinder(const Body& body, const SceneDef& scene, const std::string& origin) {
   if (body.face_labels.size() != 3 || body.vertex_restitution.size() != kRimFeatures ||
       body.vertex_friction.size() != kRimFeatures || body.vertex_rolling.size() != kRimFeatures)
     throw SceneError(origin, "die.shape", body.kind, "the body is incomplete (labels or materials missing)");
-  DieModel m;
-  m.name = scene.name;
-  m.kind = body.kind;
+  DieModel m = start_model(body, scene);
+  const MassProperties& mp = m.mass_geometric;
   m.read_down = false;
   m.rounding = body.cylinder.rounding;
-  m.mass_geometric = body.mass;
-  const MassProperties& mp = m.mass_geometric;
-  m.mass = mp.mass;
-  m.principal_moments = mp.principal_moments;
-  m.geo_to_body = mp.principal_axes.transpose();
-  m.symmetric_top = is_symmetric_top(m.principal_moments);
 
   Rims& rim = m.rims;
   rim.on = true;
@@ -203,19 +209,11 @@ DieModel compile_body(const Body& body, const SceneDef& scene, const std::string
       body.vertex_restitution.size() != nv || body.vertex_friction.size() != nv)
     throw SceneError(origin, "die.shape", body.kind, "the body is incomplete (corners, faces, normals, labels or materials missing)");
 
-  DieModel m;
-  m.name = scene.name;
-  m.kind = body.kind;
+  DieModel m = start_model(body, scene);
+  const MassProperties& mp = m.mass_geometric;
   m.convex = body.convex;
   m.read_down = body.read_down;
   m.rounding = shape.rounding;
-  m.mass_geometric = body.mass;
-  const MassProperties& mp = m.mass_geometric;
-
-  m.mass = mp.mass;
-  m.principal_moments = mp.principal_moments;
-  m.geo_to_body = mp.principal_axes.transpose();
-  m.symmetric_top = is_symmetric_top(m.principal_moments);
 
   m.vertices.resize(nv);
   m.vertex_restitution.resize(nv);
