@@ -229,6 +229,16 @@ class Reader {
     return v;
   }
 
+  // A direction: an array of 3 numbers, not all 0 (`meaning`: what it is, for the message).
+  Vec3 direction(std::string_view key, const Vec3& fallback, bool required, const std::string& meaning) {
+    const toml::node* n = get(key);
+    const std::string allowed = "an array of 3 numbers, not all 0" + (meaning.empty() ? "" : ": " + meaning);
+    if (!n && required) fail_missing(key, allowed);
+    const Vec3 v = vec3(key, kAnyNumber, fallback, false);
+    if (v.isZero(0.0)) fail(n, path_of(key), "must be " + allowed);
+    return v;
+  }
+
   std::optional<std::string> string(std::string_view key) {
     const toml::node* n = get(key);
     if (!n) return std::nullopt;
@@ -424,10 +434,7 @@ void read_die(Reader die, const std::map<std::string, MaterialDef>& materials, D
   def.base_material = material_ref(die, materials);
   for (Reader& label : die.tables("labels")) {
     LabelDef ld;
-    const toml::node* normal = label.get("normal");
-    if (!normal) label.fail_missing("normal", "an array of 3 numbers, not all 0: the face's outward direction");
-    ld.normal = label.vec3("normal", kAnyNumber, ld.normal, false);
-    if (ld.normal.isZero(0.0)) label.fail(normal, label.path_of("normal"), "must be an array of 3 numbers, not all 0");
+    ld.normal = label.direction("normal", ld.normal, true, "the face's outward direction");
     if (!label.get("label")) label.fail_missing("label", "an integer in [0, 999]");
     ld.label = label.integer("label", 0, 999, ld.label);
     label.finish();
@@ -438,10 +445,7 @@ void read_die(Reader die, const std::map<std::string, MaterialDef>& materials, D
     rd.material = material_ref(region, materials);
     for (Reader& cut : region.tables("cuts")) {
       HalfSpace h;
-      const toml::node* normal = cut.get("normal");
-      if (!normal) cut.fail_missing("normal", "an array of 3 numbers, not all 0");
-      h.normal = cut.vec3("normal", kAnyNumber, h.normal, false);
-      if (h.normal.isZero(0.0)) cut.fail(normal, cut.path_of("normal"), "must be an array of 3 numbers, not all 0");
+      h.normal = cut.direction("normal", h.normal, true, "");
       h.offset = cut.number("offset", kLength, h.offset);
       cut.finish();
       rd.half_spaces.push_back(h);
@@ -503,10 +507,7 @@ void read_throw(Reader th, ThrowDef& def) {
     def.spin.magnitude.sd = spin.number("sd", kSpinSd, def.spin.magnitude.sd);
   }
   if (kind == SpinKind::BodyAxis) {
-    const toml::node* axis = spin.get("axis");
-    def.spin.axis = spin.vec3("axis", kAnyNumber, def.spin.axis, false);
-    if (def.spin.axis.isZero(0.0))
-      spin.fail(axis, spin.path_of("axis"), "must be an array of 3 numbers, not all 0: the spin axis in the die's frame");
+    def.spin.axis = spin.direction("axis", def.spin.axis, false, "the spin axis in the die's frame");
     def.spin.tilt_deg.mean = spin.number("tilt_deg", kAngle, def.spin.tilt_deg.mean);
     def.spin.tilt_deg.sd = spin.number("tilt_sd_deg", kTiltSd, def.spin.tilt_deg.sd);
   }
