@@ -32,7 +32,7 @@ void RunCounts::merge(const RunCounts& o) {
   unresolved += o.unresolved;
   invalid += o.invalid;
   bounces += o.bounces;
-  corrections.merge(o.corrections);
+  corrections.add(o.corrections);
 }
 
 RunCounts run_tosses(const DieModel& m, const RunConfig& cfg) {

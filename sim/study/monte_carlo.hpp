@@ -13,25 +13,6 @@
 
 namespace dicesim {
 
-// Totals over a run of the per-toss corrections (sim/dynamics/corrections.hpp): all should be 0.
-struct RunCorrections {
-  std::uint64_t energy_clamps = 0, pgs_unconverged = 0, overlap_fixes = 0, fallbacks = 0;
-  bool any() const { return energy_clamps || pgs_unconverged || overlap_fixes || fallbacks; }
-  void add(const Corrections& c) {
-    energy_clamps += c.energy_clamps;
-    pgs_unconverged += c.pgs_unconverged;
-    overlap_fixes += c.overlap_fixes;
-    fallbacks += c.fallbacks;
-  }
-  void merge(const RunCorrections& o) {
-    energy_clamps += o.energy_clamps;
-    pgs_unconverged += o.pgs_unconverged;
-    overlap_fixes += o.overlap_fixes;
-    fallbacks += o.fallbacks;
-  }
-  bool operator==(const RunCorrections&) const = default;
-};
-
 struct RunCounts {
   RunCounts() = default;
   explicit RunCounts(int outcomes) : faces(static_cast<std::size_t>(outcomes), 0) {}
@@ -40,7 +21,7 @@ struct RunCounts {
   std::vector<std::uint64_t> faces = std::vector<std::uint64_t>(6, 0);
   std::uint64_t settled = 0, unresolved = 0, invalid = 0;
   std::uint64_t bounces = 0;  // impacts over all tosses
-  RunCorrections corrections;  // guards and fallbacks over all tosses
+  RunCorrections corrections;  // guards and fallbacks over all tosses (sim/dynamics/corrections.hpp)
 
   std::uint64_t total() const { return settled + unresolved + invalid; }
   void add(const TossResult& r);
