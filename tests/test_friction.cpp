@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include "fidelity_test_util.hpp"
 #include "sim/dynamics/contact.hpp"
@@ -9,6 +10,7 @@
 #include "sim/dynamics/friction_impact.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/models/toss_random.hpp"
+#include "sim/scene/scene.hpp"
 
 using namespace dicesim;
 using namespace dicesim::testing;
@@ -401,4 +403,69 @@ length = 0.02
   const ImpactResult imp = apply_friction_impact(m, s, c, /*restitution=*/true);
   EXPECT_EQ(imp.corrections.fallbacks, 1u);
   EXPECT_LE(imp.energy_after, imp.energy_before * (1.0 + 1e-12));
+}
+
+// Edges where the restitution phase's friction solve stalled (Gauss-Seidel at its cap, then
+// semismooth Newton at a kink): pre-impact states captured from `dicesim toss --fidelity impulse
+// -n 100000 -j 1` (seed 1) on Die 1 (two) and Die 2 (one), hex floats so they replay exactly.
+// The exact active-set solve of two points settles them: no pgs_unconverged, and Coulomb's law
+// with maximal dissipation at both corners (this test fails on the Gauss-Seidel-and-Newton path,
+// which counted all three unconverged).
+TEST(FrictionImpact, EdgeRestitutionFrictionStallsAreSolvedExactly) {
+  struct Stalled {
+    const char* scene;
+    int v0, v1;
+    double R[9], x[3], v[3], w[3];
+  };
+  const Stalled cases[] = {
+      {"scenes/paper/die1.toml", 0, 4,
+       {0x1.0a33d914552a1p-1, -0x1.039f508502273p-1, 0x1.5ff5fc5573d75p-1, 0x1.f7eff2e3f2baep-2, -0x1.eb7afface76cfp-2,
+        -0x1.73d7eb274b3a6p-1, 0x1.657ae6e9b613cp-1, 0x1.6e8a62adb7e2ap-1, 0x1.d6198d7224p-25},
+       {0x1.b46bfa443f75dp-3, -0x1.458eff892fc3bp-1, 0x1.5b87a98c2654ep-6},
+       {-0x1.3fd33c4bc103ep-10, -0x1.4d2b5e65c96b3p-6, -0x1.f7b23bc1a0035p-6},
+       {-0x1.92a532300e21ap+0, -0x1.2666713e1d916p+1, 0x1.3a45d8218bd0fp-6}},
+      {"scenes/paper/die1.toml", 0, 2,
+       {0x1.debad8ac2517ap-2, 0x1.657cfad476f8bp-1, -0x1.159475cd60128p-1, -0x1.d2ea8b48a6006p-2, 0x1.6e885be6034ep-1,
+        0x1.0ebb11bba00c3p-1, 0x1.83be9344ff362p-1, -0x1.5404cadfp-21, 0x1.4e5cca0e06de8p-1},
+       {-0x1.53ba69474e2e4p-2, -0x1.26ff5b8c43906p-2, 0x1.819d5d90d9bp-6},
+       {-0x1.5001d81e38a78p-1, -0x1.23c4361af1f1fp-1, -0x1.3a2f8be2d7eaep+2},
+       {-0x1.a5c1b517abc88p+4, -0x1.26a0521c9d1e8p-3, -0x1.4f4e17a9a3161p+4}},
+      {"scenes/paper/die2.toml", 1, 5,
+       {-0x1.62d2fa658c6aep-1, -0x1.5d59ef629381bp-1, -0x1.dc9cee007b77dp-3, -0x1.53a011e5866e2p-3, -0x1.4e630f1e91c0bp-3,
+        0x1.f1f1387fd06f8p-1, -0x1.6736cd9c4083dp-1, 0x1.6cd7661a9fd74p-1, 0x1.a6ad491eb8p-26},
+       {0x1.06a7c7c1c97a1p-3, 0x1.a8893c4b11d1cp-3, 0x1.5b8bf04fb5928p-6},
+       {-0x1.59d9323e20c43p-6, 0x1.42e83c92f9549p-6, -0x1.28638d86718ep-6},
+       {0x1.80078247c3dd6p+0, -0x1.5a3700d7f11e8p-2, -0x1.0dc5039b4f94dp-4}},
+  };
+  for (const Stalled& st : cases) {
+    const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/" + st.scene));
+    RigidState s;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) s.R(i, j) = st.R[3 * i + j];
+    s.position = Vec3(st.x[0], st.x[1], st.x[2]);
+    s.velocity = Vec3(st.v[0], st.v[1], st.v[2]);
+    s.omega = Vec3(st.w[0], st.w[1], st.w[2]);
+    ContactSet c;
+    c.n = 2;
+    c.vertex[0] = st.v0;
+    c.vertex[1] = st.v1;
+    const double scale = s.velocity.norm() + s.omega.norm() * m.bounding_radius;
+    const double e0 = kinetic_energy(m, s);
+    ContactImpulses P;
+    const ImpactResult r = apply_friction_impact(m, s, c, true, nullptr, &P);
+    EXPECT_EQ(r.corrections.pgs_unconverged, 0u) << st.scene << " vertices " << st.v0 << ", " << st.v1;
+    EXPECT_EQ(r.corrections.fallbacks, 0u);
+    EXPECT_EQ(r.corrections.energy_clamps, 0u);
+    EXPECT_LE(kinetic_energy(m, s), e0);
+    ASSERT_EQ(P.n, 2);
+    for (int i = 0; i < 2; ++i) {
+      const Vec3& p = P.P[i];
+      const double mu = m.vertex_friction[c.vertex[i]];
+      const double pt = std::hypot(p.x(), p.y());
+      EXPECT_GE(p.z(), 0.0);
+      EXPECT_LE(pt, mu * p.z() * (1.0 + 1e-9) + 1e-15);
+      const Vec3 u = corner_velocity(m, s, c.vertex[i]);
+      EXPECT_GE(u.z(), -1e-9 * scale);
+    }
+  }
 }

@@ -7,7 +7,10 @@
 // must be 0 (the impact law's promise); unconverged multi-contact solves are 0 since Gauss-Seidel's
 // unconverged edge solves are finished by semismooth Newton (they were ~4 in 100 `impulse` tosses:
 // sustained contact on an edge near the stick-slip boundary; the faces and bounces did not change);
-// a change in any of them is a change in the physics as well.
+// a change in any of them is a change in the physics as well. The exact two-point solve of the
+// restitution phase's friction (active sets, replacing Gauss-Seidel there) changed `stepped` Die 1's
+// bounces 2021 -> 2023 over its 100 tosses (faces unchanged: the solutions agree to the solvers'
+// tolerance, and a few chaotic trajectories amplify that); `impulse` did not change.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -79,7 +82,7 @@ TEST(ImpulseRegression, CountsArePinned) {
 
 TEST(SteppedRegression, CountsArePinned) {
   const Golden golden[] = {
-      {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2021, {0, 0, 0, 0}},
+      {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2023, {0, 0, 0, 0}},
       {"scenes/paper/die2.toml", {15, 16, 21, 15, 16, 17}, 2153, {0, 0, 0, 0}},
       {"scenes/paper/die3.toml", {14, 20, 13, 22, 21, 10}, 1983, {0, 0, 0, 0}},
       {"scenes/fair.toml", {13, 16, 14, 15, 25, 17}, 2081, {0, 0, 0, 0}},
