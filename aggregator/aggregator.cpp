@@ -271,7 +271,10 @@ void Aggregator::on_status(const dicesim_lcm::worker_status& s, double now) {
   w.rate = std::isfinite(s.tosses_per_s) && s.tosses_per_s > 0 ? s.tosses_per_s : 0.0;
   if (s.run_id == 0 || s.state == 0) {  // has not got (or not yet compiled) our run: tell it again
     w.ready = false;
-    if (now - last_run_start_ > 0.02) publish_run_start(), last_run_start_ = now;
+    // At most one announcement per 20 ms (a storm of new workers), but never a lost one: a worker
+    // that asked just after an announcement it missed gets the next, from tick, not the periodic one.
+    run_start_wanted_ = true;
+    if (now - last_run_start_ > 0.02) publish_run_start(), last_run_start_ = now, run_start_wanted_ = false;
     return;
   }
   if (s.state == 2) {
@@ -374,7 +377,8 @@ int Aggregator::live_workers() const {
 void Aggregator::tick(double now) {
   if (started_ < 0) started_ = rate_t_ = now;
   if (!finished_) {
-    if (now - last_run_start_ >= cfg_.run_start_period_s) publish_run_start(), last_run_start_ = now;
+    if (now - last_run_start_ >= cfg_.run_start_period_s || (run_start_wanted_ && now - last_run_start_ > 0.02))
+      publish_run_start(), last_run_start_ = now, run_start_wanted_ = false;
     for (auto it = workers_.begin(); it != workers_.end();) {
       if (now - it->second.last_seen <= cfg_.worker_timeout_s) {
         ++it;

@@ -150,6 +150,7 @@ class Aggregator {
   std::map<std::int64_t, bool> refused_;
   bool finished_ = false;
   double last_probabilities_ = -1e9, last_run_start_ = -1e9, started_ = -1.0;
+  bool run_start_wanted_ = false;  // a worker asked for run_start within 20 ms of the last one
   double rate_ = 0.0, rate_t_ = 0.0;
   std::uint64_t rate_n_ = 0;
 };

@@ -244,3 +244,31 @@ TEST(AggregatorRun, WorkerRefusesAModelItCannotRebuild) {
 }
 
 }  // namespace
+
+namespace {
+
+// A worker that asks for the run (status state 0) just after an announcement it missed gets the
+// next announcement about 20 ms later, not the periodic one (1 s): `run` waited for the
+// worker's 200 ms heartbeat before this.
+TEST(AggregatorRun, AWorkerAskingJustAfterAnAnnouncementGetsTheNextWithin20ms) {
+  Fixture f(1000);
+  std::vector<double> announced;
+  double now = 0.0;
+  agg::Aggregator a(f.cfg, [&](const char* ch, const std::vector<std::uint8_t>&) {
+    if (std::string(ch) == wire::kRunStart) announced.push_back(now);
+  });
+  a.tick(now);
+  ASSERT_EQ(announced.size(), 1u);
+  dicesim_lcm::worker_status s{};
+  s.worker_id = 7;
+  s.state = 0;
+  now = 0.005;
+  const auto sb = wire::encode(s);
+  a.on_message(wire::kWorkerStatus, sb.data(), sb.size(), now);
+  EXPECT_EQ(announced.size(), 1u) << "within 20 ms of the last: not at once";
+  for (int i = 1; i <= 5; ++i) now = 0.005 + 0.01 * i, a.tick(now);
+  ASSERT_EQ(announced.size(), 2u) << "the asked-for announcement must come from tick";
+  EXPECT_LE(announced[1], 0.04);
+}
+
+}  // namespace

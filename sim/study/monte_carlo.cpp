@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -63,17 +65,23 @@ RunCounts run_tosses(const DieModel& m, const RunConfig& cfg) {
     if (!cfg.progress) {
       work(partial[0]);
     } else {
-      // The calling thread works too, so progress comes from a mostly sleeping reporter thread.
-      std::atomic<bool> finished{false};
+      // The calling thread works too, so progress comes from a mostly sleeping reporter thread,
+      // woken at once when the work ends (a plain 100 ms sleep added up to 0.1 s to every run).
+      std::mutex mu;
+      std::condition_variable cv;
+      bool finished = false;
       std::jthread reporter([&] {
-        while (!finished.load()) {
-          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        std::unique_lock lock(mu);
+        while (!cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return finished; }))
           cfg.progress(done.load(), cfg.tosses);
-        }
       });
       work(partial[0]);
       for (auto& th : pool) th.join();
-      finished = true;
+      {
+        std::lock_guard lock(mu);
+        finished = true;
+      }
+      cv.notify_one();
     }
   }
   RunCounts total(m.outcomes());
