@@ -1,8 +1,12 @@
 // Helpers shared by the fidelity-ladder tests (test_fidelity_*, test_friction*, test_rest*, test_extremes*).
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <array>
 #include <cstdint>
+#include <cstdio>
+#include <string>
 #include <vector>
 
 #include "scenes_for_tests.hpp"
@@ -48,6 +52,40 @@ inline RunCounts run(const DieModel& m, std::uint64_t n, std::uint64_t seed = 1,
   cfg.tosses = n;
   cfg.threads = threads;
   return run_tosses(m, cfg);
+}
+
+// A pinned run of one ready scene (test_paper_regression.cpp, test_impulse_regression.cpp).
+struct Golden {
+  const char* scene;
+  std::array<std::uint64_t, 6> faces;  // by face index: +x, -x, +y, -y, +z, -z
+  std::uint64_t bounces;
+  // energy clamps, unconverged contact solves, overlap fixes, fallbacks: pinned too (the target
+  // is 0; what they are today is recorded so that a change is seen).
+  std::array<std::uint64_t, 4> corrections{};
+};
+
+// Runs g.scene in fidelity f, n tosses, seed 20261122 on 2 threads, and checks every pinned
+// number; on a failure prints the actual values as a Golden line (how the pins are regenerated).
+inline void check_pinned(const Golden& g, Fidelity f, std::uint64_t n) {
+  const DieModel m = compile(with_fidelity(load_scene(std::string(DICESIM_SOURCE_DIR) + "/" + g.scene), f));
+  const RunCounts c = run(m, n, 20261122);
+  const std::string what = std::string(to_string(f)) + " " + g.scene;
+  EXPECT_EQ(c.faces, in_label_order(m, g.faces)) << what;
+  EXPECT_EQ(c.bounces, g.bounces) << what;
+  EXPECT_EQ(c.settled, n) << what;
+  const std::array<std::uint64_t, 4> corr = {c.corrections.energy_clamps, c.corrections.pgs_unconverged,
+                                             c.corrections.overlap_fixes, c.corrections.fallbacks};
+  EXPECT_EQ(corr, g.corrections) << what;
+  EXPECT_EQ(c.corrections.energy_clamps, 0u) << what;  // the impact law's promise
+  if (::testing::Test::HasFailure()) {  // the actual values, by face index as pinned
+    std::array<std::uint64_t, 6> bf{};
+    for (std::size_t k = 0; k < 6; ++k) bf[k] = c.faces[static_cast<std::size_t>(m.face_outcome[k])];
+    std::printf("      {\"%s\", {%llu, %llu, %llu, %llu, %llu, %llu}, %llu, {%llu, %llu, %llu, %llu}},\n", g.scene,
+                (unsigned long long)bf[0], (unsigned long long)bf[1], (unsigned long long)bf[2],
+                (unsigned long long)bf[3], (unsigned long long)bf[4], (unsigned long long)bf[5],
+                (unsigned long long)c.bounces, (unsigned long long)corr[0], (unsigned long long)corr[1],
+                (unsigned long long)corr[2], (unsigned long long)corr[3]);
+  }
 }
 
 }  // namespace dicesim::testing

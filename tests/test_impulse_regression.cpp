@@ -13,62 +13,14 @@
 // tolerance, and a few chaotic trajectories amplify that); `impulse` did not change.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
-#include <string>
-
 #include "fidelity_test_util.hpp"
-#include "sim/models/compile.hpp"
-#include "sim/scene/scene.hpp"
-#include "sim/study/monte_carlo.hpp"
 
 namespace {
 
 using namespace dicesim;
 
-struct Golden {
-  const char* scene;
-  std::array<std::uint64_t, 6> faces;  // by face index: +x, -x, +y, -y, +z, -z
-  std::uint64_t bounces;
-  // energy clamps, unconverged contact solves, overlap fixes, fallbacks: pinned too (the target
-  // is 0; what they are today is recorded so that a change is seen).
-  std::array<std::uint64_t, 4> corrections;
-};
-
-DieModel model(const char* scene, Fidelity f) {
-  SceneDef def = load_scene(std::string(DICESIM_SOURCE_DIR) + "/" + scene);
-  def.sim.fidelity = f;
-  return compile(def);
-}
-
-RunCounts run(const DieModel& m, std::uint64_t n) {
-  RunConfig cfg;
-  cfg.seed = 20261122;
-  cfg.tosses = n;
-  cfg.threads = 2;
-  return run_tosses(m, cfg);
-}
-
-void check(const Golden& g, Fidelity f, std::uint64_t n) {
-  const DieModel m = model(g.scene, f);
-  const RunCounts c = run(m, n);
-  EXPECT_EQ(c.faces, dicesim::testing::in_label_order(m, g.faces)) << to_string(f) << " " << g.scene;
-  EXPECT_EQ(c.bounces, g.bounces) << to_string(f) << " " << g.scene;
-  EXPECT_EQ(c.settled, n) << to_string(f) << " " << g.scene;
-  const std::array<std::uint64_t, 4> corr = {c.corrections.energy_clamps, c.corrections.pgs_unconverged,
-                                             c.corrections.overlap_fixes, c.corrections.fallbacks};
-  EXPECT_EQ(corr, g.corrections) << to_string(f) << " " << g.scene;
-  EXPECT_EQ(c.corrections.energy_clamps, 0u) << to_string(f) << " " << g.scene;  // the law's promise
-  if (::testing::Test::HasFailure()) {  // the actual values, by face index as pinned
-    std::array<std::uint64_t, 6> bf{};
-    for (std::size_t k = 0; k < 6; ++k) bf[k] = c.faces[static_cast<std::size_t>(m.face_outcome[k])];
-    std::printf("      {\"%s\", {%llu, %llu, %llu, %llu, %llu, %llu}, %llu, {%llu, %llu, %llu, %llu}},\n", g.scene,
-                (unsigned long long)bf[0], (unsigned long long)bf[1], (unsigned long long)bf[2],
-                (unsigned long long)bf[3], (unsigned long long)bf[4], (unsigned long long)bf[5],
-                (unsigned long long)c.bounces, (unsigned long long)corr[0], (unsigned long long)corr[1],
-                (unsigned long long)corr[2], (unsigned long long)corr[3]);
-  }
-}
+using dicesim::testing::check_pinned;
+using dicesim::testing::Golden;
 
 TEST(ImpulseRegression, CountsArePinned) {
   const Golden golden[] = {
@@ -77,7 +29,7 @@ TEST(ImpulseRegression, CountsArePinned) {
       {"scenes/paper/die3.toml", {200, 462, 304, 322, 479, 233}, 44995, {0, 0, 0, 0}},
       {"scenes/fair.toml", {319, 332, 347, 338, 308, 356}, 42470, {0, 0, 0, 0}},
   };
-  for (const Golden& g : golden) check(g, Fidelity::Impulse, 2000);
+  for (const Golden& g : golden) check_pinned(g, Fidelity::Impulse, 2000);
 }
 
 TEST(SteppedRegression, CountsArePinned) {
@@ -87,7 +39,7 @@ TEST(SteppedRegression, CountsArePinned) {
       {"scenes/paper/die3.toml", {14, 20, 13, 22, 21, 10}, 1983, {0, 0, 0, 0}},
       {"scenes/fair.toml", {13, 16, 14, 15, 25, 17}, 2081, {0, 0, 0, 0}},
   };
-  for (const Golden& g : golden) check(g, Fidelity::Stepped, 100);
+  for (const Golden& g : golden) check_pinned(g, Fidelity::Stepped, 100);
 }
 
 }  // namespace

@@ -6,32 +6,14 @@
 // test and copy the "actual" values after checking the change is intended.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <string>
-#include <vector>
-
 #include "fidelity_test_util.hpp"
-#include "sim/models/compile.hpp"
-#include "sim/study/monte_carlo.hpp"
-#include "sim/scene/scene.hpp"
 
 namespace {
 
 using namespace dicesim;
 
-struct Golden {
-  const char* scene;
-  std::array<std::uint64_t, 6> faces;  // by face index: +x, -x, +y, -y, +z, -z
-  std::uint64_t bounces;
-};
-
-RunCounts run(const DieModel& m) {
-  RunConfig cfg;
-  cfg.seed = 20261122;
-  cfg.tosses = 20000;
-  cfg.threads = 2;
-  return run_tosses(m, cfg);
-}
+using dicesim::testing::check_pinned;
+using dicesim::testing::Golden;
 
 TEST(PaperRegression, CountsArePinned) {
   const Golden golden[] = {
@@ -40,13 +22,7 @@ TEST(PaperRegression, CountsArePinned) {
       {"scenes/paper/die3.toml", {3113, 3635, 3348, 3341, 3558, 3005}, 33626},
       {"scenes/fair.toml", {3380, 3372, 3268, 3359, 3262, 3359}, 34138},
   };
-  for (const Golden& g : golden) {
-    const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/" + g.scene));
-    const RunCounts c = run(m);
-    EXPECT_EQ(c.faces, dicesim::testing::in_label_order(m, g.faces)) << g.scene;
-    EXPECT_EQ(c.bounces, g.bounces) << g.scene;
-    EXPECT_EQ(c.settled, 20000u) << g.scene;
-  }
+  for (const Golden& g : golden) check_pinned(g, Fidelity::Paper, 20000);
 }
 
 }  // namespace
