@@ -18,8 +18,9 @@ struct CmdRun {
   std::string out;
 };
 
-CmdRun dicesim(const std::string& args) {
-  const std::string cmd = std::string("cd ") + DICESIM_SOURCE_DIR + " && " + DICESIM_BINARY + " " + args + " 2>/dev/null";
+// dicesim ARGS from the source folder, stderr to `err` (a path): exit code and stdout.
+CmdRun dicesim_to(const std::string& args, const std::string& err) {
+  const std::string cmd = std::string("cd ") + DICESIM_SOURCE_DIR + " && " + DICESIM_BINARY + " " + args + " 2>" + err;
   CmdRun r;
   FILE* p = popen(cmd.c_str(), "r");
   char buf[4096];
@@ -29,6 +30,8 @@ CmdRun dicesim(const std::string& args) {
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
+
+CmdRun dicesim(const std::string& args) { return dicesim_to(args, "/dev/null"); }
 
 }  // namespace
 
@@ -69,14 +72,7 @@ struct FullRun {
 };
 FullRun dicesim_full(const std::string& args) {
   const std::string errf = ::testing::TempDir() + "dicesim_lcmcli_err_" + std::to_string(::getpid());
-  const std::string cmd = std::string("cd ") + DICESIM_SOURCE_DIR + " && " + DICESIM_BINARY + " " + args + " 2>" + errf;
-  CmdRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const CmdRun r = dicesim_to(args, errf);
   std::ifstream in(errf);
   std::string err((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   std::remove(errf.c_str());
