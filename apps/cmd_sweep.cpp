@@ -17,6 +17,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/progress.hpp"
+#include "apps/report.hpp"
 #include "apps/sweep_workers.hpp"
 #include "messages/wire.hpp"
 #include "sim/study/compare.hpp"
@@ -33,6 +34,7 @@ struct SweepArgs {
   std::string param, values, value_template = "{}";
   double scale = 1.0, shift = 0.0;
   std::vector<std::string> overrides;
+  std::string fidelity;      // non-empty: sim.fidelity at every point (as toss --fidelity)
   std::uint64_t tosses = 0;  // 0: the file's (or 10 000)
   std::uint64_t seed = 0;    // 0 given explicitly is a valid seed: track with the option
   CLI::Option* seed_opt = nullptr;
@@ -214,6 +216,7 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
                         {"settled", r.counts.settled},
                         {"unresolved", r.counts.unresolved},
                         {"invalid", r.counts.invalid},
+                        {"corrections", corrections_json(r.counts.corrections)},
                         {"faces", faces}};
     const SeedMatch m = match_seed(spec, seed_rows, r);
     if (m.found) {
@@ -276,6 +279,12 @@ std::string table_text(const SweepSpec& spec, const SweepResult& res, int thread
                   static_cast<unsigned long long>(r.counts.invalid));
     out << line;
   }
+  RunCorrections all;
+  for (const SweepPointResult& r : res.points) {
+    all.add(r.counts.corrections);
+    if (r.counts.corrections.any()) out << "point " << r.point.label << ": " << corrections_line(r.counts.corrections);
+  }
+  if (all.any()) out << "whole sweep: " << corrections_line(all);
   out << "\np over settled tosses; widest 95% Wilson half-width " << fmt("%.4f", worst) << "; "
       << fmt("%.2f", res.elapsed_s) << " s\n";
   return out.str();
@@ -342,8 +351,9 @@ std::string markdown_text(const SweepSpec& spec, const SweepResult& res, const s
   return md.str();
 }
 
-int run_sweep_cmd(const SweepArgs& a) {
+int run_sweep_cmd(SweepArgs a) {
   if (!fs::is_regular_file(a.input)) throw SceneError(a.input, "", "", "cannot open file");
+  if (!a.fidelity.empty()) a.overrides.push_back("sim.fidelity=\"" + a.fidelity + "\"");
   if (a.json && a.csv == "-") throw SceneError("dicesim sweep", "--csv", "-", "stdout carries the --json object; write the CSV to a file");
   const bool file_mode = is_sweep_file(a.input);
   SweepSpec spec;
@@ -422,6 +432,7 @@ void register_sweep(CLI::App& app, int& exit_code) {
       "Examples:\n"
       "  dicesim sweep scenes/paper/die1.toml --param throw.height.mean --values 0.4:4.2:0.2\n"
       "  dicesim sweep scenes/paper/die1.toml --param floor.restitution --values 0.1,0.5,0.9 -n 20000 --json\n"
+      "  dicesim sweep scenes/paper/die1.toml --param floor.friction --values 0.1:0.7:0.2 --fidelity impulse\n"
       "  dicesim sweep scenes/paper/die1.toml --param throw.velocity.mean --template '[{}, 0, 0]' \\\n"
       "      --values 0.5:15:0.5 --csv vx.csv --plot vx.png\n"
       "  dicesim sweep scenes/paper/sweeps/volume-ratio.toml --plot ratio.png --markdown ratio.md\n"
@@ -440,6 +451,9 @@ void register_sweep(CLI::App& app, int& exit_code) {
   a->scale_opt = cmd->add_option("--scale", a->scale, "Scene value = scale * x + shift (default 1)")->type_name("A");
   a->shift_opt = cmd->add_option("--shift", a->shift, "(default 0)")->type_name("B");
   cmd->add_option("--set", a->overrides, "Override a scene key at every point, KEY=VALUE; repeatable")->type_name("KEY=VALUE");
+  cmd->add_option("--fidelity", a->fidelity,
+                  "Physical model at every point (the scene's sim.fidelity otherwise): static, paper, impulse, stepped, auto")
+      ->type_name("F");
   cmd->add_option("-n,--tosses", a->tosses, "Tosses per point (default: the sweep file's, else 10000)")
       ->check(CLI::Range(1ULL, 1ULL << 40));
   a->seed_opt = cmd->add_option("--seed", a->seed, "Run seed (default: the sweep file's, else 1)");

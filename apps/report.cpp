@@ -41,6 +41,24 @@ double rate(const RunReport& r) { return r.elapsed_s > 0.0 ? static_cast<double>
 
 }  // namespace
 
+nlohmann::json corrections_json(const RunCorrections& k) {
+  return {{"energy_clamps", k.energy_clamps},
+          {"pgs_unconverged", k.pgs_unconverged},
+          {"overlap_fixes", k.overlap_fixes},
+          {"fallbacks", k.fallbacks}};
+}
+
+std::string corrections_line(const RunCorrections& k) {
+  if (!k.any()) return {};
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "corrections: %llu energy clamps, %llu unconverged contact solves, %llu overlap fixes, %llu fallbacks "
+                "(each should be 0: the physics was repaired)\n",
+                static_cast<unsigned long long>(k.energy_clamps), static_cast<unsigned long long>(k.pgs_unconverged),
+                static_cast<unsigned long long>(k.overlap_fixes), static_cast<unsigned long long>(k.fallbacks));
+  return line;
+}
+
 nlohmann::json report_json(const RunReport& r) {
   nlohmann::json faces = nlohmann::json::array();
   for (const FaceRow& f : face_rows(r))
@@ -57,11 +75,7 @@ nlohmann::json report_json(const RunReport& r) {
           {"faces", faces},
           {"chi2_uniform", {{"statistic", chi.statistic}, {"dof", chi.dof}, {"p_value", chi.p_value}}},
           {"bounces_per_toss", r.tosses ? static_cast<double>(r.counts.bounces) / static_cast<double>(r.tosses) : 0.0},
-          {"corrections",
-           {{"energy_clamps", r.counts.corrections.energy_clamps},
-            {"pgs_unconverged", r.counts.corrections.pgs_unconverged},
-            {"overlap_fixes", r.counts.corrections.overlap_fixes},
-            {"fallbacks", r.counts.corrections.fallbacks}}},
+          {"corrections", corrections_json(r.counts.corrections)},
           {"elapsed_s", r.elapsed_s},
           {"tosses_per_s", rate(r)}};
 }
@@ -83,15 +97,7 @@ std::string report_table(const RunReport& r) {
                 static_cast<unsigned long long>(r.counts.settled), static_cast<unsigned long long>(r.counts.unresolved),
                 static_cast<unsigned long long>(r.counts.invalid));
   out += line;
-  const RunCorrections& k = r.counts.corrections;
-  if (k.any()) {
-    std::snprintf(line, sizeof line,
-                  "corrections: %llu energy clamps, %llu unconverged contact solves, %llu overlap fixes, %llu fallbacks "
-                  "(each should be 0: the physics was repaired)\n",
-                  static_cast<unsigned long long>(k.energy_clamps), static_cast<unsigned long long>(k.pgs_unconverged),
-                  static_cast<unsigned long long>(k.overlap_fixes), static_cast<unsigned long long>(k.fallbacks));
-    out += line;
-  }
+  out += corrections_line(r.counts.corrections);
   const ChiSquare chi = chi2_fair(r);
   std::snprintf(line, sizeof line, "chi-square vs a fair die: %.2f on %d dof, p = %.3g\n", chi.statistic, chi.dof, chi.p_value);
   out += line;

@@ -31,6 +31,10 @@ struct RunReport {
 //  intervals over settled tosses, faces by label (N outcomes; chi-square on N - 1 dof against every
 //  face equally likely, grouped labels weighted by their faces).
 nlohmann::json report_json(const RunReport& r);
+// {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks"}: the run's totals (toss, run, sweep points).
+nlohmann::json corrections_json(const RunCorrections& k);
+// "corrections: N energy clamps, ... (each should be 0: the physics was repaired)", or "" when all are 0.
+std::string corrections_line(const RunCorrections& k);
 // Fills labels and faces_per_label from the model.
 void set_labels(RunReport& r, const DieModel& m);
 std::string report_table(const RunReport& r);

@@ -47,6 +47,32 @@ TEST(CliSweep, JsonHasEveryPointAndFace) {
   }
 }
 
+// Each point carries its corrections (issue 13: every guard counted and reported), the same as a
+// toss of that point reports, and the table names the points where any is non-zero. The quarter on
+// a table is the scene with the most (unconverged rim solves); where all are 0 the line is absent.
+TEST(CliSweep, EveryPointReportsItsCorrectionsAsTossDoes) {
+  const std::string args = "--fidelity impulse -n 60 --seed 5";
+  const CliRun r = cli("sweep scenes/coins/quarter-table.toml --param floor.restitution --values 0.5 " + args + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["fidelity"], "impulse");
+  const auto p = nlohmann::json::parse(r.out)["points"][0];
+  const CliRun t = cli("toss scenes/coins/quarter-table.toml --set floor.restitution=0.5 " + args + " --json");
+  ASSERT_EQ(t.code, 0) << t.err;
+  const auto k = nlohmann::json::parse(t.out)["corrections"];
+  bool any = false;
+  for (const char* key : {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks"}) {
+    ASSERT_TRUE(p["corrections"].contains(key)) << key;
+    EXPECT_EQ(p["corrections"][key], k[key]) << key;
+    any = any || k[key].get<long long>() > 0;
+  }
+  const CliRun table = cli("sweep scenes/coins/quarter-table.toml --param floor.restitution --values 0.5 " + args);
+  ASSERT_EQ(table.code, 0) << table.err;
+  EXPECT_EQ(table.out.find("point 0.5: corrections: ") != std::string::npos, any) << table.out;
+  EXPECT_EQ(table.out.find("whole sweep: corrections: ") != std::string::npos, any) << table.out;
+  expect_bad_input(cli("sweep scenes/coins/quarter-table.toml --param floor.restitution --values 0.5 --fidelity fast"),
+                   {"sim.fidelity", "fast"});
+}
+
 TEST(CliSweep, CsvColumnsAndVectorTemplate) {
   const CliRun r = cli("sweep scenes/paper/die1.toml --param throw.velocity.mean --template '[{}, 0, 0]' "
                            "--values 1:3:1 -n 300 --csv -");
