@@ -74,12 +74,18 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
 
   // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact).
   const Vec3 L = world_inertia(m, s.R) * s.omega;
-  const TorqueFreeRotation rot(m.principal_moments, s.R, L);
+  // Built in place (the full step's is kept for model_G; the object is large, so no copies).
+  const TorqueFreeRotation& rot = (full ? full_rot_ : trial_rot_).emplace(m.principal_moments, s.R, L);
   rot_start_ = s.R;
   const Vec3 p = s.position, v = s.velocity;
-  a.G = lowest_new(c, p, v, rot, d);
+  // Every body point lies within the bounding radius of the COM (|bottom row| = 1 to rounding, far
+  // inside the relative 1e-9): a full step that ends with the COM that far above the floor cannot
+  // bring a corner below it, and its G is only compared with -touch_tol (the shortened steps'
+  // search, which needs G's value, never starts from such a step). Most of `stepped`'s steps are
+  // in the air: this skips their corner heights (and the rotation's evaluation for them).
+  const double clear = p.z() + v.z() * d - (1.0 + 1e-9) * m.bounding_radius;
+  a.G = full && clear > 0.0 ? clear : lowest_new(c, p, v, rot, d);
   if (full) {
-    full_rot_ = rot;
     full_p_ = p;
     full_v_ = v;
   }
@@ -164,22 +170,24 @@ int FixedStepper::step(RigidState& s) {
     bool have_lo = false;
     int side = 0;
     done = nullptr;
+    Attempt* trial = &b_;
+    Attempt* lo = &lo_;
     for (int k = 0; k < kMaxTrials; ++k) {
-      try_step(s0, c, d, b_);
-      if (std::abs(b_.G) <= touch_tol_) {
-        done = &b_;
+      try_step(s0, c, d, *trial);
+      if (std::abs(trial->G) <= touch_tol_) {
+        done = trial;
         dt = d;
         break;
       }
       const double span = d * (h_ - d);
-      const double miss = span > 0.0 ? (b_.G - model_G(c, d)) / span : 0.0;
-      const bool above = b_.G > 0.0;
+      const double miss = span > 0.0 ? (trial->G - model_G(c, d)) / span : 0.0;
+      const bool above = trial->G > 0.0;
       if (above) {
-        d_lo = d, g_lo = b_.G;
-        std::swap(b_, lo_);
+        d_lo = d, g_lo = trial->G;
+        std::swap(trial, lo);  // the attempts are large: swap who is which, not their contents
         have_lo = true;
       } else {
-        d_hi = d, g_hi = b_.G;
+        d_hi = d, g_hi = trial->G;
       }
       // Defect correction (twice at most) while the corrected model brackets a root in [d_lo, d_hi].
       modelled = modelled && k < 2 && corrected_G(c, miss, d_lo) > 0.0 && corrected_G(c, miss, d_hi) <= 0.0;
@@ -206,11 +214,11 @@ int FixedStepper::step(RigidState& s) {
       // Not within the tolerance in kMaxTrials trials (the touch is nearly tangential): the longest
       // trial that ends above the floor; the corner touches in the next step.
       if (have_lo) {
-        done = &lo_;
+        done = lo;
         dt = d_lo;
       } else {  // every trial ended below: the shortest, its corner within rounding of the floor
-        try_step(s0, c, d_hi, b_);
-        done = &b_;
+        try_step(s0, c, d_hi, *trial);
+        done = trial;
         dt = d_hi;
       }
     }
@@ -229,7 +237,12 @@ int FixedStepper::step(RigidState& s) {
     sweeps += static_cast<std::uint64_t>(a.sup.iterations);
     max_energy_gain = std::max(max_energy_gain, relative_gain(a.sup.energy_before, a.sup.energy_after));
   }
-  warm_ = a.next;
+  // (Only the used entries: ContactImpulses holds kMaxContacts of them.)
+  warm_.n = a.next.n;
+  for (int i = 0; i < a.next.n; ++i) {
+    warm_.vertex[i] = a.next.vertex[i];
+    warm_.P[i] = a.next.P[i];
+  }
   dt_ = dt;
   max_energy_gain = std::max(max_energy_gain, relative_gain(E0, mechanical_energy(m, s)));
   return c.n;

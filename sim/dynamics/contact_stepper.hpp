@@ -15,6 +15,8 @@
 // the largest relative gain seen, for the tests.
 #pragma once
 
+#include <optional>
+
 #include "sim/body/die_model.hpp"
 #include "sim/dynamics/corrections.hpp"
 #include "sim/dynamics/flight.hpp"
@@ -72,7 +74,7 @@ class FixedStepper {
   // the smaller gravity kick of a step of length t changes, g (h - t) t. Exact for a step without
   // contact (the rotation is the same); with contact the solve absorbs part of the kick.
   double model_G(const ContactSet& c, double t) const {
-    return lowest_new(c, full_p_, full_v_, full_rot_, t) + m_->gravity * (h_ - t) * t;
+    return lowest_new(c, full_p_, full_v_, *full_rot_, t) + m_->gravity * (h_ - t) * t;
   }
   // The model corrected by a trial's miss: model_G(t) + miss t (h - t) (the model is exact at
   // t = 0, the step's start, and at t = h, the full step itself).
@@ -88,7 +90,8 @@ class FixedStepper {
   Mat3 rot_start_ = Mat3::Identity();  // orientation at the start of the step being tried
   Attempt a_, b_, lo_;                  // trial steps (members: ContactImpulses is large)
   ContactImpulses warm_;  // the last plastic solve's impulses (warm start of the next)
-  TorqueFreeRotation full_rot_;  // the full step's free motion (model_G)
+  std::optional<TorqueFreeRotation> full_rot_;   // the full step's free motion (model_G)
+  std::optional<TorqueFreeRotation> trial_rot_;  // a shortened trial's
   Vec3 full_p_ = Vec3::Zero(), full_v_ = Vec3::Zero();
   bool impact_ = false;   // the current step starts with an impact (solved once for all its trials)
   ImpactResult imp_;      // that impact's result
