@@ -117,6 +117,36 @@ double FixedStepper::model_root(const ContactSet& c, double miss, double lo, dou
   return mid;
 }
 
+long long FixedStepper::coast(RigidState& s, long long max_k) const {
+  const DieModel& m = *m_;
+  // High: COM above z_min. The margin (1e-6 of the radius, far above the rounding of the closed
+  // form against step by step) keeps every coasted step clear of the floor by construction.
+  const double z_min = (1.0 + 1e-6) * m.bounding_radius + touch_tol_;
+  const double z0 = s.position.z(), vz = s.velocity.z(), g = m.gravity, h = h_;
+  if (!(z0 > z_min) || max_k < 2) return 0;
+  // z_j = z0 + j h vz - g h^2 j (j + 1) / 2 is concave in j: the steps that stay high are j <= the
+  // positive root of z_j = z_min.
+  const double a = 0.5 * g * h * h, b = 0.5 * g * h * h - h * vz, c = z_min - z0;  // a j^2 + b j + c = 0, c < 0
+  const double disc = b * b - 4.0 * a * c;
+  const double root = b > 0.0 ? -2.0 * c / (b + std::sqrt(disc)) : (std::sqrt(disc) - b) / (2.0 * a);
+  const auto z_at = [&](double j) { return z0 + j * h * vz - a * j * (j + 1.0); };
+  double k = std::floor(std::min(root, static_cast<double>(max_k)));
+  while (k > 0.0 && !(z_at(k) > z_min)) k -= 1.0;  // rounding of the root: the largest j that is high
+  // Step j ends at z_{j+1}: the K steps' ends are z_1..z_K, all high (concavity: between z_0 and z_K
+  // every z_j is at least min(z_0, z_K)).
+  if (k < 2.0) return 0;
+  const double T = k * h;
+  const Vec3 L = world_inertia(m, s.R) * s.omega;
+  const TorqueFreeRotation rot(m.principal_moments, s.R, L);
+  Vec3 w;
+  rot.state(T, s.R, w);
+  s.omega = w;
+  s.position += T * s.velocity;
+  s.position.z() -= a * k * (k + 1.0);
+  s.velocity.z() -= k * g * h;
+  return static_cast<long long>(k);
+}
+
 // Trials of the shortened step's length (each a whole step) before taking the best one.
 constexpr int kMaxTrials = 12;
 
@@ -277,6 +307,15 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
     if (f >= 0) {
       out.face_down = f;
       return finish(StepperExit::Settled);
+    }
+    if (!allow_liftoff) {  // `stepped`: a flight high above the floor in closed form
+      const long long coasted = st.coast(s, max_steps - k - 1);
+      if (coasted > 0) {
+        for (long long j = 0; j < coasted; ++j) t += h;  // as the steps would have added it
+        k += coasted;
+        steps += static_cast<std::uint64_t>(coasted);
+        if (!(k < max_steps && t < m.max_time)) break;
+      }
     }
     const int n = st.step(s);
     ++steps;

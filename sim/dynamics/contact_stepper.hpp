@@ -51,6 +51,16 @@ class FixedStepper {
   // Returns the number of corners that were in contact at the step's start.
   int step(RigidState& s);
 
+  // `stepped`'s flights in closed form: from s, with the COM at least the bounding radius above
+  // the floor, the number K <= max_k of whole steps (each h) after which every step's start and
+  // end would still be that high, and s advanced by them at once. Such steps touch nothing, give
+  // no impulse and cannot end in rest (the COM is above every basin's escape height); each is the
+  // same map (gravity's kick g h, then straight COM motion and the exact torque-free rotation for
+  // h), so K of them are v_K = v - K g h, p_K = p + K h v - g h^2 K (K + 1) / 2 e_z, and the
+  // rotation for K h from the one angular momentum (constant in flight). The same discrete motion
+  // as K calls of step(), to rounding. Returns K (0: s unchanged).
+  long long coast(RigidState& s, long long max_k) const;
+
   double h() const { return h_; }
   double last_dt() const { return dt_; }
   int impacts = 0;                // steps whose contact solve had restitution
