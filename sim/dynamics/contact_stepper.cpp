@@ -123,7 +123,9 @@ long long FixedStepper::coast(RigidState& s, long long max_k) const {
   // form against step by step) keeps every coasted step clear of the floor by construction.
   const double z_min = (1.0 + 1e-6) * m.bounding_radius + touch_tol_;
   const double z0 = s.position.z(), vz = s.velocity.z(), g = m.gravity, h = h_;
-  if (!(z0 > z_min) || max_k < 2) return 0;
+  // (No rest: energy >= m g z > m g r >= m g max_escape, the rest criteria's bound; a die with
+  // one basin only, max_escape infinite, rests at once and never coasts.)
+  if (!(z0 > z_min) || max_k < 2 || !(m.max_escape <= m.bounding_radius)) return 0;
   // z_j = z0 + j h vz - g h^2 j (j + 1) / 2 is concave in j: the steps that stay high are j <= the
   // positive root of z_j = z_min.
   const double a = 0.5 * g * h * h, b = 0.5 * g * h * h - h * vz, c = z_min - z0;  // a j^2 + b j + c = 0, c < 0
