@@ -486,7 +486,13 @@ TEST(Stepper, CoastIsTheStepsItReplaces) {
     const double h = 1e-4;
     FixedStepper st(m, h);
     RigidState a = s0, b = s0;
-    const long long k = st.coast(a, 1000000);
+    double t = 0.0;
+    const long long k = st.coast(a, t, 10.0, 1000000);
+    EXPECT_EQ(t, [&] {
+      double u = 0.0;
+      for (long long j = 0; j < k; ++j) u += h;
+      return u;
+    }());
     ASSERT_GT(k, 1000);  // up and down again: ~0.3 s of flight
     for (long long j = 0; j < k; ++j) {
       ASSERT_EQ(st.step(b), 0);
@@ -507,6 +513,14 @@ TEST(Stepper, CoastIsTheStepsItReplaces) {
     // The last high step: one more would end within the margin of the bounding radius.
     EXPECT_GT(a.position.z(), m.bounding_radius);
     EXPECT_LE(a.position.z() + h * (a.velocity.z() - m.gravity * h), (1.0 + 1e-6) * m.bounding_radius + 1e-7 * m.bounding_radius);
-    EXPECT_EQ(st.coast(a, 1000000), 0);
+    EXPECT_EQ(st.coast(a, t, 10.0, 1000000), 0);
+    // The time cap: a flight coasted up to max_time stops where the steps would.
+    RigidState c = s0;
+    double tc = 0.0;
+    const long long kc = st.coast(c, tc, 0.05, 1000000);
+    long long expect = 0;
+    for (double u = 0.0; u < 0.05; u += h) ++expect;  // the steps' loop: run while t < max_time
+    EXPECT_EQ(kc, expect);
+    EXPECT_GE(tc, 0.05);
   }
 }

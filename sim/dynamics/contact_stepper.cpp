@@ -117,7 +117,7 @@ double FixedStepper::model_root(const ContactSet& c, double miss, double lo, dou
   return mid;
 }
 
-long long FixedStepper::coast(RigidState& s, long long max_k) const {
+long long FixedStepper::coast(RigidState& s, double& t, double max_time, long long max_k) const {
   const DieModel& m = *m_;
   // High: COM above z_min. The margin (1e-6 of the radius, far above the rounding of the closed
   // form against step by step) keeps every coasted step clear of the floor by construction.
@@ -136,7 +136,17 @@ long long FixedStepper::coast(RigidState& s, long long max_k) const {
   while (k > 0.0 && !(z_at(k) > z_min)) k -= 1.0;  // rounding of the root: the largest j that is high
   // Step j ends at z_{j+1}: the K steps' ends are z_1..z_K, all high (concavity: between z_0 and z_K
   // every z_j is at least min(z_0, z_K)).
+  // The time cap as the steps would meet it: step j runs only if t (after j steps' additions of
+  // h, in that order) is still below max_time.
+  double t_end = t;
+  long long steps = 0;
+  while (static_cast<double>(steps) < k && t_end < max_time) {
+    t_end += h;
+    ++steps;
+  }
+  k = static_cast<double>(steps);
   if (k < 2.0) return 0;
+  t = t_end;
   const double T = k * h;
   const Vec3 L = world_inertia(m, s.R) * s.omega;
   const TorqueFreeRotation rot(m.principal_moments, s.R, L);
@@ -311,9 +321,8 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       return finish(StepperExit::Settled);
     }
     if (!allow_liftoff) {  // `stepped`: a flight high above the floor in closed form
-      const long long coasted = st.coast(s, max_steps - k - 1);
+      const long long coasted = st.coast(s, t, m.max_time, max_steps - k - 1);
       if (coasted > 0) {
-        for (long long j = 0; j < coasted; ++j) t += h;  // as the steps would have added it
         k += coasted;
         steps += static_cast<std::uint64_t>(coasted);
         if (!(k < max_steps && t < m.max_time)) break;

@@ -58,8 +58,9 @@ class FixedStepper {
   // same map (gravity's kick g h, then straight COM motion and the exact torque-free rotation for
   // h), so K of them are v_K = v - K g h, p_K = p + K h v - g h^2 K (K + 1) / 2 e_z, and the
   // rotation for K h from the one angular momentum (constant in flight). The same discrete motion
-  // as K calls of step(), to rounding. Returns K (0: s unchanged).
-  long long coast(RigidState& s, long long max_k) const;
+  // as K calls of step(), to rounding. t advances by K additions of h, as the steps add it, and K
+  // stops where t reaches max_time (the steps' own time cap). Returns K (0: s, t unchanged).
+  long long coast(RigidState& s, double& t, double max_time, long long max_k) const;
 
   double h() const { return h_; }
   double last_dt() const { return dt_; }
