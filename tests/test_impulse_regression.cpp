@@ -11,6 +11,11 @@
 // restitution phase's friction (active sets, replacing Gauss-Seidel there) changed `stepped` Die 1's
 // bounces 2021 -> 2023 over its 100 tosses (faces unchanged: the solutions agree to the solvers'
 // tolerance, and a few chaotic trajectories amplify that); `impulse` did not change.
+// `stepped`'s flights high above the floor in closed form (FixedStepper::coast: the same discrete
+// motion as the steps, to rounding; the closed form keeps |L| to 1e-15 where ~5000 steps drifted
+// 2e-10) moved one toss's face on each of Die 2, Die 3 and the fair die (of 100) and the bounces by
+// +3 / -8 / +5 / +5; the agreement check (20 000 Die 1 tosses against `impulse`) is unchanged:
+// chi-square p 0.585 -> 0.594, largest face difference +0.0060 -> +0.0059, both inside 95%.
 #include <gtest/gtest.h>
 
 #include "fidelity_test_util.hpp"
@@ -34,10 +39,10 @@ TEST(ImpulseRegression, CountsArePinned) {
 
 TEST(SteppedRegression, CountsArePinned) {
   const Golden golden[] = {
-      {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2023, {0, 0, 0, 0}},
-      {"scenes/paper/die2.toml", {15, 16, 21, 15, 16, 17}, 2153, {0, 0, 0, 0}},
-      {"scenes/paper/die3.toml", {14, 20, 13, 22, 21, 10}, 1983, {0, 0, 0, 0}},
-      {"scenes/fair.toml", {13, 16, 14, 15, 25, 17}, 2081, {0, 0, 0, 0}},
+      {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2026, {0, 0, 0, 0}},
+      {"scenes/paper/die2.toml", {15, 15, 21, 16, 16, 17}, 2145, {0, 0, 0, 0}},
+      {"scenes/paper/die3.toml", {14, 19, 14, 22, 21, 10}, 1988, {0, 0, 0, 0}},
+      {"scenes/fair.toml", {14, 16, 14, 15, 25, 16}, 2086, {0, 0, 0, 0}},
   };
   for (const Golden& g : golden) check_pinned(g, Fidelity::Stepped, 100);
 }

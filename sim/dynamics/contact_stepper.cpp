@@ -74,12 +74,18 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
 
   // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact).
   const Vec3 L = world_inertia(m, s.R) * s.omega;
-  const TorqueFreeRotation rot(m.principal_moments, s.R, L);
+  // Built in place (the full step's is kept for model_G; the object is large, so no copies).
+  const TorqueFreeRotation& rot = (full ? full_rot_ : trial_rot_).emplace(m.principal_moments, s.R, L);
   rot_start_ = s.R;
   const Vec3 p = s.position, v = s.velocity;
-  a.G = lowest_new(c, p, v, rot, d);
+  // Every body point lies within the bounding radius of the COM (|bottom row| = 1 to rounding, far
+  // inside the relative 1e-9): a full step that ends with the COM that far above the floor cannot
+  // bring a corner below it, and its G is only compared with -touch_tol (the shortened steps'
+  // search, which needs G's value, never starts from such a step). Most of `stepped`'s steps are
+  // in the air: this skips their corner heights (and the rotation's evaluation for them).
+  const double clear = p.z() + v.z() * d - (1.0 + 1e-9) * m.bounding_radius;
+  a.G = full && clear > 0.0 ? clear : lowest_new(c, p, v, rot, d);
   if (full) {
-    full_rot_ = rot;
     full_p_ = p;
     full_v_ = v;
   }
@@ -109,6 +115,48 @@ double FixedStepper::model_root(const ContactSet& c, double miss, double lo, dou
     }
   }
   return mid;
+}
+
+long long FixedStepper::coast(RigidState& s, double& t, double max_time, long long max_k) const {
+  const DieModel& m = *m_;
+  // High: COM above z_min. The margin (1e-6 of the radius, far above the rounding of the closed
+  // form against step by step) keeps every coasted step clear of the floor by construction.
+  const double z_min = (1.0 + 1e-6) * m.bounding_radius + touch_tol_;
+  const double z0 = s.position.z(), vz = s.velocity.z(), g = m.gravity, h = h_;
+  // (No rest: energy >= m g z > m g r >= m g max_escape, the rest criteria's bound; a die with
+  // one basin only, max_escape infinite, rests at once and never coasts.)
+  if (!(z0 > z_min) || max_k < 2 || !(m.max_escape <= m.bounding_radius)) return 0;
+  // z_j = z0 + j h vz - g h^2 j (j + 1) / 2 is concave in j: the steps that stay high are j <= the
+  // positive root of z_j = z_min.
+  const double a = 0.5 * g * h * h, b = 0.5 * g * h * h - h * vz, c = z_min - z0;  // a j^2 + b j + c = 0, c < 0
+  const double disc = b * b - 4.0 * a * c;
+  const double root = b > 0.0 ? -2.0 * c / (b + std::sqrt(disc)) : (std::sqrt(disc) - b) / (2.0 * a);
+  const auto z_at = [&](double j) { return z0 + j * h * vz - a * j * (j + 1.0); };
+  double k = std::floor(std::min(root, static_cast<double>(max_k)));
+  while (k > 0.0 && !(z_at(k) > z_min)) k -= 1.0;  // rounding of the root: the largest j that is high
+  // Step j ends at z_{j+1}: the K steps' ends are z_1..z_K, all high (concavity: between z_0 and z_K
+  // every z_j is at least min(z_0, z_K)).
+  // The time cap as the steps would meet it: step j runs only if t (after j steps' additions of
+  // h, in that order) is still below max_time.
+  double t_end = t;
+  long long steps = 0;
+  while (static_cast<double>(steps) < k && t_end < max_time) {
+    t_end += h;
+    ++steps;
+  }
+  k = static_cast<double>(steps);
+  if (k < 2.0) return 0;
+  t = t_end;
+  const double T = k * h;
+  const Vec3 L = world_inertia(m, s.R) * s.omega;
+  const TorqueFreeRotation rot(m.principal_moments, s.R, L);
+  Vec3 w;
+  rot.state(T, s.R, w);
+  s.omega = w;
+  s.position += T * s.velocity;
+  s.position.z() -= a * k * (k + 1.0);
+  s.velocity.z() -= k * g * h;
+  return static_cast<long long>(k);
 }
 
 // Trials of the shortened step's length (each a whole step) before taking the best one.
@@ -164,22 +212,24 @@ int FixedStepper::step(RigidState& s) {
     bool have_lo = false;
     int side = 0;
     done = nullptr;
+    Attempt* trial = &b_;
+    Attempt* lo = &lo_;
     for (int k = 0; k < kMaxTrials; ++k) {
-      try_step(s0, c, d, b_);
-      if (std::abs(b_.G) <= touch_tol_) {
-        done = &b_;
+      try_step(s0, c, d, *trial);
+      if (std::abs(trial->G) <= touch_tol_) {
+        done = trial;
         dt = d;
         break;
       }
       const double span = d * (h_ - d);
-      const double miss = span > 0.0 ? (b_.G - model_G(c, d)) / span : 0.0;
-      const bool above = b_.G > 0.0;
+      const double miss = span > 0.0 ? (trial->G - model_G(c, d)) / span : 0.0;
+      const bool above = trial->G > 0.0;
       if (above) {
-        d_lo = d, g_lo = b_.G;
-        std::swap(b_, lo_);
+        d_lo = d, g_lo = trial->G;
+        std::swap(trial, lo);  // the attempts are large: swap who is which, not their contents
         have_lo = true;
       } else {
-        d_hi = d, g_hi = b_.G;
+        d_hi = d, g_hi = trial->G;
       }
       // Defect correction (twice at most) while the corrected model brackets a root in [d_lo, d_hi].
       modelled = modelled && k < 2 && corrected_G(c, miss, d_lo) > 0.0 && corrected_G(c, miss, d_hi) <= 0.0;
@@ -206,11 +256,11 @@ int FixedStepper::step(RigidState& s) {
       // Not within the tolerance in kMaxTrials trials (the touch is nearly tangential): the longest
       // trial that ends above the floor; the corner touches in the next step.
       if (have_lo) {
-        done = &lo_;
+        done = lo;
         dt = d_lo;
       } else {  // every trial ended below: the shortest, its corner within rounding of the floor
-        try_step(s0, c, d_hi, b_);
-        done = &b_;
+        try_step(s0, c, d_hi, *trial);
+        done = trial;
         dt = d_hi;
       }
     }
@@ -229,7 +279,12 @@ int FixedStepper::step(RigidState& s) {
     sweeps += static_cast<std::uint64_t>(a.sup.iterations);
     max_energy_gain = std::max(max_energy_gain, relative_gain(a.sup.energy_before, a.sup.energy_after));
   }
-  warm_ = a.next;
+  // (Only the used entries: ContactImpulses holds kMaxContacts of them.)
+  warm_.n = a.next.n;
+  for (int i = 0; i < a.next.n; ++i) {
+    warm_.vertex[i] = a.next.vertex[i];
+    warm_.P[i] = a.next.P[i];
+  }
   dt_ = dt;
   max_energy_gain = std::max(max_energy_gain, relative_gain(E0, mechanical_energy(m, s)));
   return c.n;
@@ -264,6 +319,14 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
     if (f >= 0) {
       out.face_down = f;
       return finish(StepperExit::Settled);
+    }
+    if (!allow_liftoff) {  // `stepped`: a flight high above the floor in closed form
+      const long long coasted = st.coast(s, t, m.max_time, max_steps - k - 1);
+      if (coasted > 0) {
+        k += coasted;
+        steps += static_cast<std::uint64_t>(coasted);
+        if (!(k < max_steps && t < m.max_time)) break;
+      }
     }
     const int n = st.step(s);
     ++steps;

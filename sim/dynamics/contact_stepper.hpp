@@ -15,6 +15,8 @@
 // the largest relative gain seen, for the tests.
 #pragma once
 
+#include <optional>
+
 #include "sim/body/die_model.hpp"
 #include "sim/dynamics/corrections.hpp"
 #include "sim/dynamics/flight.hpp"
@@ -49,6 +51,17 @@ class FixedStepper {
   // Returns the number of corners that were in contact at the step's start.
   int step(RigidState& s);
 
+  // `stepped`'s flights in closed form: from s, with the COM at least the bounding radius above
+  // the floor, the number K <= max_k of whole steps (each h) after which every step's start and
+  // end would still be that high, and s advanced by them at once. Such steps touch nothing, give
+  // no impulse and cannot end in rest (the COM is above every basin's escape height); each is the
+  // same map (gravity's kick g h, then straight COM motion and the exact torque-free rotation for
+  // h), so K of them are v_K = v - K g h, p_K = p + K h v - g h^2 K (K + 1) / 2 e_z, and the
+  // rotation for K h from the one angular momentum (constant in flight). The same discrete motion
+  // as K calls of step(), to rounding. t advances by K additions of h, as the steps add it, and K
+  // stops where t reaches max_time (the steps' own time cap). Returns K (0: s, t unchanged).
+  long long coast(RigidState& s, double& t, double max_time, long long max_k) const;
+
   double h() const { return h_; }
   double last_dt() const { return dt_; }
   int impacts = 0;                // steps whose contact solve had restitution
@@ -72,7 +85,7 @@ class FixedStepper {
   // the smaller gravity kick of a step of length t changes, g (h - t) t. Exact for a step without
   // contact (the rotation is the same); with contact the solve absorbs part of the kick.
   double model_G(const ContactSet& c, double t) const {
-    return lowest_new(c, full_p_, full_v_, full_rot_, t) + m_->gravity * (h_ - t) * t;
+    return lowest_new(c, full_p_, full_v_, *full_rot_, t) + m_->gravity * (h_ - t) * t;
   }
   // The model corrected by a trial's miss: model_G(t) + miss t (h - t) (the model is exact at
   // t = 0, the step's start, and at t = h, the full step itself).
@@ -88,7 +101,8 @@ class FixedStepper {
   Mat3 rot_start_ = Mat3::Identity();  // orientation at the start of the step being tried
   Attempt a_, b_, lo_;                  // trial steps (members: ContactImpulses is large)
   ContactImpulses warm_;  // the last plastic solve's impulses (warm start of the next)
-  TorqueFreeRotation full_rot_;  // the full step's free motion (model_G)
+  std::optional<TorqueFreeRotation> full_rot_;   // the full step's free motion (model_G)
+  std::optional<TorqueFreeRotation> trial_rot_;  // a shortened trial's
   Vec3 full_p_ = Vec3::Zero(), full_v_ = Vec3::Zero();
   bool impact_ = false;   // the current step starts with an impact (solved once for all its trials)
   ImpactResult imp_;      // that impact's result
