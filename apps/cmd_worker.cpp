@@ -1,4 +1,6 @@
 // dicesim worker: a toss-worker process for distributed runs (sim/worker does the work).
+#include <unistd.h>
+
 #include <csignal>
 #include <cstdio>
 
@@ -58,6 +60,9 @@ int serve_forked_worker(const std::string& url, const std::string& key_file, con
   a.once = true;
   a.quiet = true;
   a.key_file = key_file;
+  // tests/integration (run_cmd) checks for this line: the fast path must not fall back unnoticed.
+  spdlog::debug("worker process {} forked by `dicesim run` (no exec): serving run {} with the run's compiled model",
+                static_cast<long>(getpid()), run.spec.run_id);
   try {
     return run_worker_cmd(a, &run);
   } catch (const std::exception& e) {  // e.g. the key file went away since the parent read it
