@@ -22,7 +22,7 @@ bool WorkerProcesses::spawn(const std::string& url, std::int64_t run_id, const s
   const pid_t parent = getpid();
   const bool in_process = prepared && prepared->spec.run_id == run_id && thread_count() == 1;
   const std::string run = std::to_string(run_id);
-  // Built before fork: the child only execs.
+  // Built before fork: the child then only execs (when it does not serve the run in-process).
   std::vector<std::string> args = {"dicesim", "worker", "--lcm", url, "--quiet"};
   if (run_id != 0) args.insert(args.end(), {"--run", run, "--once"});
   if (!key_file.empty()) args.insert(args.end(), {"--key-file", key_file});
