@@ -30,7 +30,7 @@ struct AggregatorConfig {
   // valid outcome list (wire::valid_outcome_labels), else the constructor throws invalid_argument.
   wire::RunSpec spec;
   double target_halfwidth = 0.0;    // > 0: stop at the first block boundary where it holds
-  std::uint64_t max_lease = 8192;   // tosses per lease at most (a few hundred ms of one core)
+  std::uint64_t max_lease = 32768;  // tosses per lease at most (tens of ms of `paper`, ~1 s of `impulse`)
   std::uint64_t min_lease = 512;    // ... and at least, except for the last ones
   int leases_per_worker = 2;        // one in progress, one queued: a worker never waits
   double worker_timeout_s = 2.0;    // no heartbeat or batch for this long: its leases go elsewhere

@@ -84,8 +84,20 @@ DieModel rebuild_checkpoint_model(const agg::Checkpoint& ck, const std::string& 
   return model;
 }
 
+PreparedRun prepare_run(const AggregateArgs& a, std::int64_t run_id) {
+  // Bad input fails here, before anything is published (SceneError -> exit 2 in run_cli).
+  DieModel model = compile(a.scene.load(), a.scene.path);
+  std::vector<std::string> overrides = a.scene.overrides;  // as SceneArgs::load composes them
+  if (!a.scene.fidelity.empty()) overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
+  const std::uint64_t total = a.target_halfwidth > 0 && a.tosses_opt && a.tosses_opt->count() == 0 ? kTargetCap : a.tosses;
+  wire::RunSpec spec = wire::make_run_spec(run_id != 0 ? run_id : wire::new_run_id(), a.scene.path, overrides, model, a.seed,
+                                           total, a.trace_every);
+  return {std::move(model), std::move(spec)};
+}
+
 int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::int64_t run_id, int workers,
-                         const std::function<std::string()>& on_tick, const std::atomic<bool>* cancel) {
+                         const std::function<std::string()>& on_tick, const std::atomic<bool>* cancel,
+                         const PreparedRun* prepared) {
   std::optional<agg::Checkpoint> resume;
   if (!a.resume.empty()) {
     if (!a.scene.path.empty() || !a.scene.overrides.empty() || !a.scene.fidelity.empty())
@@ -96,18 +108,14 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   }
   agg::AggregatorConfig cfg;
   cfg.key = load_run_key(a.key_file);  // KeyError -> exit 2, before anything is published
-  // Bad input fails here, before anything is published (SceneError -> exit 2 in run_cli).
-  const DieModel model = resume ? rebuild_checkpoint_model(*resume, a.resume) : compile(a.scene.load(), a.scene.path);
+  std::optional<PreparedRun> compiled;
+  if (!resume && !prepared) compiled = prepare_run(a, run_id);
+  const DieModel model = resume ? rebuild_checkpoint_model(*resume, a.resume) : prepared ? prepared->model : compiled->model;
   if (resume) {
     cfg.spec = wire::from_message(resume->start);
     cfg.target_halfwidth = resume->target_halfwidth;
   } else {
-    std::vector<std::string> overrides = a.scene.overrides;  // as SceneArgs::load composes them
-    if (!a.scene.fidelity.empty()) overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
-    const std::uint64_t total =
-        a.target_halfwidth > 0 && a.tosses_opt && a.tosses_opt->count() == 0 ? kTargetCap : a.tosses;
-    cfg.spec = wire::make_run_spec(run_id != 0 ? run_id : wire::new_run_id(), a.scene.path, overrides, model, a.seed,
-                                   total, a.trace_every);
+    cfg.spec = prepared ? prepared->spec : compiled->spec;
     cfg.target_halfwidth = a.target_halfwidth;
   }
   const wire::RunSpec& spec = cfg.spec;

@@ -57,6 +57,18 @@ void print_info(const std::string& path, const DieModel& m) {
     std::printf("  %4zu  (%+.6f, %+.6f, %+.6f)  e = %.4f  mu = %.3f\n", c, geo.x(), geo.y(), geo.z(),
                 m.vertex_restitution[c], m.vertex_friction[c]);
   }
+  if (m.curved()) {
+    // A cylinder has no corners: its contact features are points of these two core circles.
+    std::printf("rims (core circles, swept by the rounding; restitution, friction, rolling resistance)\n");
+    for (int k = 0; k < 2 && 3 * k < static_cast<int>(m.vertex_rolling.size()); ++k) {
+      const double sgn = k == 0 ? 1.0 : -1.0;
+      const Vec3 c = m.geo_to_body.transpose() * (m.rims.centre + sgn * m.rims.half * m.rims.axis) + mp.com;
+      const std::size_t v = static_cast<std::size_t>(3 * k);
+      std::printf("  %-5s centre (%+.6f, %+.6f, %+.6f)  radius %.6g  e = %.4f  mu = %.3f  rolling %.3g m\n",
+                  kCylinderOutcomeNames[static_cast<std::size_t>(k)], c.x(), c.y(), c.z(), m.rims.radius,
+                  m.vertex_restitution[v], m.vertex_friction[v], m.vertex_rolling[v]);
+    }
+  }
   std::printf("\nfidelity           %s", to_string(m.fidelity));
   if (m.fidelity_requested == Fidelity::Auto) std::printf(" (chosen by auto)");
   std::printf("\n  why              %s\n", m.fidelity_reason.c_str());

@@ -24,10 +24,11 @@ struct RunArgs {
 };
 
 int run_run(const RunArgs& a) {
-  // Bad input (scene or key file): exit 2 before any child starts.
-  wire::check_wire_outcomes(compile(a.agg.scene.load(), a.agg.scene.path), a.agg.scene.path);
+  // Bad input (scene or key file): exit 2 before any child starts. The run is compiled once, here:
+  // the workers forked below start with it (worker_processes.hpp).
+  const PreparedRun prepared = prepare_run(a.agg, wire::new_run_id());
   (void)load_run_key(a.agg.key_file);
-  const std::int64_t run_id = wire::new_run_id();
+  const std::int64_t run_id = prepared.spec.run_id;
   // --lcm or $LCM_DEFAULT_URL if given; else the host-confined group on a port of this run's own.
   std::string url = wire::resolve_url(a.agg.lcm);
   if (a.agg.lcm.empty() && url == wire::kDefaultUrl)
@@ -37,7 +38,7 @@ int run_run(const RunArgs& a) {
   std::signal(SIGTERM, on_stop_signal);
   WorkerProcesses children;
   for (int k = 0; k < a.workers; ++k)
-    if (!children.spawn(url, run_id, a.agg.key_file)) {
+    if (!children.spawn(url, run_id, a.agg.key_file, &prepared)) {
       std::fprintf(stderr, "dicesim: failed: cannot start worker %d\n", k + 1);
       return kExitFailed;
     }
@@ -47,7 +48,7 @@ int run_run(const RunArgs& a) {
         // After Ctrl-C the workers (same process group) exit too: that is the interrupt, not a failure.
         return children.poll() == 0 && !g_stop ? "every worker process exited before the run finished" : "";
       },
-      &g_stop);
+      &g_stop, &prepared);
   children.stop_all();
   return code;
 }

@@ -1,4 +1,6 @@
 // dicesim worker: a toss-worker process for distributed runs (sim/worker does the work).
+#include <unistd.h>
+
 #include <csignal>
 #include <cstdio>
 
@@ -21,14 +23,15 @@ struct WorkerArgs {
   std::int64_t run = 0;
   bool once = false;
   bool quiet = false;
-  int batch = 1024;
+  int batch = wire::kMaxBatch;
   std::string key_file;
 };
 
-int run_worker_cmd(const WorkerArgs& a) {
+int run_worker_cmd(const WorkerArgs& a, const PreparedRun* known = nullptr) {
   std::signal(SIGINT, on_stop_signal);
   std::signal(SIGTERM, on_stop_signal);
   worker::WorkerOptions opt;
+  if (known) opt.known_spec = &known->spec, opt.known_model = &known->model;
   opt.url = wire::resolve_url(a.lcm);
   opt.once = a.once;
   opt.cancel = &g_stop;
@@ -49,6 +52,24 @@ int run_worker_cmd(const WorkerArgs& a) {
 }
 
 }  // namespace
+
+int serve_forked_worker(const std::string& url, const std::string& key_file, const PreparedRun& run) {
+  WorkerArgs a;
+  a.lcm = url;
+  a.run = run.spec.run_id;
+  a.once = true;
+  a.quiet = true;
+  a.key_file = key_file;
+  // tests/integration (run_cmd) checks for this line: the fast path must not fall back unnoticed.
+  spdlog::debug("worker process {} forked by `dicesim run` (no exec): serving run {} with the run's compiled model",
+                static_cast<long>(getpid()), run.spec.run_id);
+  try {
+    return run_worker_cmd(a, &run);
+  } catch (const std::exception& e) {  // e.g. the key file went away since the parent read it
+    std::fprintf(stderr, "dicesim worker: failed: %s\n", e.what());
+    return kExitFailed;
+  }
+}
 
 void register_worker(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<WorkerArgs>();

@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "messages/run_spec.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/scene/scene.hpp"
 
@@ -64,10 +65,24 @@ struct AggregateArgs {
   void add_to(CLI::App* cmd);
   void add_checkpoint_options(CLI::App* cmd);  // --checkpoint, --resume; SCENE becomes optional
 };
+// A new run (not --resume) compiled once: its model and what run_start announces. `run` makes it
+// before forking its workers, which then start with both (no run_start wait, no compile of their own).
+struct PreparedRun {
+  DieModel model;
+  wire::RunSpec spec;
+};
+// Throws SceneError (bad input, exit 2) and std::runtime_error (a scene that does not rebuild).
+PreparedRun prepare_run(const AggregateArgs& a, std::int64_t run_id);
 // Starts the run on `url`, aggregates it to the end and prints the report as `toss` does.
 // `workers` (> 0) is reported as the thread count; `on_tick` may return an error to abort.
+// `prepared`: the run, already compiled (prepare_run with this `a`); else it is compiled here.
 int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::int64_t run_id, int workers,
-                         const std::function<std::string()>& on_tick, const std::atomic<bool>* cancel);
+                         const std::function<std::string()>& on_tick, const std::atomic<bool>* cancel,
+                         const PreparedRun* prepared = nullptr);
+// The body of `dicesim worker --lcm URL --quiet --run ID --once [--key-file FILE]` in a child that
+// `run` forked without exec (worker_processes.cpp): it serves `run` from the start. Returns the
+// exit code.
+int serve_forked_worker(const std::string& url, const std::string& key_file, const PreparedRun& run);
 
 // --log-level and --log-file on `app` and each of its subcommands; logging is set up (logger/log.hpp)
 // once parsing is complete, before the subcommand runs (log_options.cpp). parse_and_run calls it.

@@ -26,6 +26,39 @@ nlohmann::json rest_json(const DieModel& m) {
 
 Vec3 geometric_normal(const DieModel& m, std::size_t f) { return m.geo_to_body.transpose() * m.face_normals[f]; }
 
+// A cylinder's own description (its "corners" are moving rim points, so that list is empty): outer
+// size, the outcome labels by name, and its two core rim circles in the geometric frame with the
+// materials at each (rim k's features are 3 k .. 3 k + 2; they share one material mix).
+nlohmann::json cylinder_json(const DieModel& m) {
+  const Rims& r = m.rims;
+  const Mat3 to_geo = m.geo_to_body.transpose();
+  const Vec3& com = m.mass_geometric.com;
+  nlohmann::json labels = nlohmann::json::object();
+  for (std::size_t f = 0; f < kCylinderOutcomeNames.size() && f < m.face_labels.size(); ++f)
+    labels[kCylinderOutcomeNames[f]] = m.face_labels[f];
+  nlohmann::json rims = nlohmann::json::array();
+  for (int k = 0; k < 2; ++k) {
+    const double sgn = k == 0 ? 1.0 : -1.0;
+    const std::size_t feature = static_cast<std::size_t>(3 * k);
+    nlohmann::json rim = {{"face", kCylinderOutcomeNames[static_cast<std::size_t>(k)]},
+                          {"centre", vec(to_geo * (r.centre + sgn * r.half * r.axis) + com)},
+                          {"normal", vec(to_geo * (sgn * r.axis))},
+                          {"radius", r.radius}};
+    if (feature < m.vertex_restitution.size()) {
+      rim["restitution"] = m.vertex_restitution[feature];
+      rim["friction"] = m.vertex_friction[feature];
+    }
+    if (feature < m.vertex_rolling.size()) rim["rolling_resistance"] = m.vertex_rolling[feature];
+    rims.push_back(rim);
+  }
+  return {{"radius", r.radius + m.rounding},
+          {"height", 2.0 * (r.half + m.rounding)},
+          {"rounding", m.rounding},
+          {"axis", vec(to_geo * r.axis)},
+          {"labels", labels},
+          {"rims", rims}};
+}
+
 }  // namespace
 
 nlohmann::json info_json(const std::string& path, const DieModel& m) {
@@ -40,6 +73,10 @@ nlohmann::json info_json(const std::string& path, const DieModel& m) {
                            {"stable", m.face_hold[f] >= 0.0},
                            {"p_static", p_static[f]}};
     if (m.kind == "box") face["direction"] = kFaceDirNames[f];
+    if (m.curved() && f < kCylinderOutcomeNames.size()) {
+      face["direction"] = kCylinderOutcomeNames[f];  // heads (+z), tails (-z), edge: the curved side
+      face["curved"] = f == 2;                        // the side has no single normal (printed as 0)
+    }
     faces.push_back(face);
   }
   nlohmann::json corners = nlohmann::json::array();
@@ -47,7 +84,7 @@ nlohmann::json info_json(const std::string& path, const DieModel& m) {
     const Vec3 geo = m.geo_to_body.transpose() * m.vertices[c] + mp.com;
     corners.push_back({{"position", vec(geo)}, {"restitution", m.vertex_restitution[c]}, {"friction", m.vertex_friction[c]}});
   }
-  return {{"scene", path},
+  nlohmann::json j = {{"scene", path},
           {"name", m.name},
           {"shape", m.kind},
           {"convex", m.convex},
@@ -69,6 +106,8 @@ nlohmann::json info_json(const std::string& path, const DieModel& m) {
           {"fidelity_requested", to_string(m.fidelity_requested)},
           {"fidelity_reason", m.fidelity_reason},
           {"rest", rest_json(m)}};
+  if (m.curved()) j["cylinder"] = cylinder_json(m);
+  return j;
 }
 
 }  // namespace dicesim

@@ -13,7 +13,10 @@ namespace dicesim {
 // {"scene", "name", "shape", "convex", "rounding", "read", "vertex_count", "face_count", "outcomes",
 //  "mass", "com", "inertia", "principal_moments", "principal_axes", "symmetric_top", "bounding_radius",
 //  "faces": [{"label", "normal", "area", "stable", "p_static"}], "corners", "fidelity",
-//  "fidelity_requested", "fidelity_reason", "rest"}. p_static: the probability of reading the face in
+//  "fidelity_requested", "fidelity_reason", "rest"}; a cylinder adds "cylinder": {"radius", "height",
+//  "rounding", "axis", "labels": {"heads", "tails", "edge"}, "rims": [{"face", "centre", "normal",
+//  "radius" (the core rim's), "restitution", "friction", "rolling_resistance"}]} and per face
+//  "direction" (heads, tails, edge) and "curved". p_static: the probability of reading the face in
 //  `static` with a uniform orientation (its Gauss-map basin; a Fibonacci lattice of
 //  kInfoStaticDirections down directions, error ~1e-5).
 inline constexpr int kInfoStaticDirections = 200000;

@@ -272,3 +272,63 @@ TEST(AggregatorRun, AWorkerAskingJustAfterAnAnnouncementGetsTheNextWithin20ms) {
 }
 
 }  // namespace
+
+namespace {
+
+// A worker that `dicesim run` forked after compiling the run adopts it: its first status (ready)
+// brings leases before any run_start was heard, and it never compiles the scene (the spec below
+// carries no files: compiling it would fail and the worker would refuse the run).
+TEST(AggregatorRun, AnAdoptedWorkerIsLeasedAtOnceWithoutCompiling) {
+  Fixture f(3000);
+  wire::RunSpec no_files = f.cfg.spec;
+  no_files.files.clear();
+  Net net = make_net(f, 0);
+  net.add_worker();
+  net.workers[0]->adopt(no_files, f.model, 0.0);
+  ASSERT_EQ(net.queue.size(), 1u) << "adopt says at once that it is ready";
+  const Message status = net.queue.front();
+  net.queue.clear();
+  std::vector<std::string> out;
+  agg::Aggregator& a = *net.agg;
+  agg::Aggregator probe(f.cfg, [&](const char* ch, const std::vector<std::uint8_t>&) { out.emplace_back(ch); });
+  probe.on_message(status.channel, status.bytes.data(), status.bytes.size(), 0.0);
+  ASSERT_FALSE(out.empty());
+  EXPECT_EQ(out.front(), wire::kWorkLease) << "the first answer is a lease, not an announcement";
+  a.on_message(status.channel, status.bytes.data(), status.bytes.size(), 0.0);
+  ASSERT_TRUE(net.run());
+  EXPECT_TRUE(net.agg->refusals().empty()) << net.agg->refusals()[0];
+  EXPECT_EQ(net.agg->result().faces, f.reference(3000).faces);
+}
+
+// A model that is not the spec's is not used: the worker compiles the spec as any other would.
+TEST(AggregatorRun, AnAdoptedModelThatIsNotTheSpecsIsCompiledAfresh) {
+  Fixture f(2000);
+  wire::RunSpec other;
+  other.origin = DICESIM_SOURCE_DIR "/scenes/paper/die3.toml";
+  other.files = wire::read_scene_files(other.origin);
+  const DieModel wrong = wire::compile_spec(other);
+  Net net = make_net(f, 0);
+  net.add_worker();
+  net.workers[0]->adopt(f.cfg.spec, wrong, 0.0);
+  ASSERT_TRUE(net.run());
+  EXPECT_EQ(net.agg->result().faces, f.reference(2000).faces);
+}
+
+// An adopted worker can speak before the aggregator listens. If its "ready" was lost, it says it
+// again on hearing run_start, not at its next heartbeat 200 ms later.
+TEST(AggregatorRun, AnAdoptedWorkerWhoseReadyWasLostRepeatsItOnRunStart) {
+  Fixture f(1000);
+  Net net = make_net(f, 0);
+  net.add_worker();
+  net.workers[0]->adopt(f.cfg.spec, f.model, 0.0);
+  net.queue.clear();  // nobody heard it
+  net.step();         // t = 10 ms: the aggregator announces, the worker answers, a lease follows
+  net.step();
+  EXPECT_GT(net.agg->health().leases, 0u) << "leased within 20 ms";
+  EXPECT_GT(net.workers[0]->tosses_done(), 0u);
+  ASSERT_TRUE(net.run());
+  EXPECT_EQ(net.agg->result().faces, f.reference(1000).faces);
+}
+
+}  // namespace
+

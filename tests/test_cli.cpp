@@ -73,6 +73,45 @@ TEST(Cli, InfoJsonHasMassProperties) {
   EXPECT_EQ(j["principal_moments"].size(), 3u);
 }
 
+// Issue 15: a cylinder's own fields (its "corners" are moving rim points, so that list is empty).
+TEST(Cli, InfoJsonDescribesACylinder) {
+  const CliRun r = cli("info scenes/coins/quarter.toml --json --set die.faces.edge=7");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.contains("cylinder")) << r.out;
+  const auto& c = j["cylinder"];
+  EXPECT_NEAR(c["radius"].get<double>(), 0.01213, 1e-12);
+  EXPECT_NEAR(c["height"].get<double>(), 0.00175, 1e-12);
+  EXPECT_NEAR(c["rounding"].get<double>(), 0.0002, 1e-12);
+  EXPECT_EQ(c["labels"]["heads"], 1);
+  EXPECT_EQ(c["labels"]["tails"], 2);
+  EXPECT_EQ(c["labels"]["edge"], 7);  // configurable: the scene's label, not a default
+  ASSERT_EQ(c["rims"].size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    const auto& rim = c["rims"][static_cast<std::size_t>(k)];
+    const double sgn = k == 0 ? 1.0 : -1.0;
+    EXPECT_EQ(rim["face"], k == 0 ? "heads" : "tails");
+    EXPECT_NEAR(rim["radius"].get<double>(), 0.01213 - 0.0002, 1e-12);  // the core rim, swept by the rounding
+    EXPECT_NEAR(rim["centre"][2].get<double>(), sgn * (0.00175 / 2 - 0.0002), 1e-12);
+    EXPECT_NEAR(rim["centre"][0].get<double>(), 0.0, 1e-12);
+    EXPECT_NEAR(rim["normal"][2].get<double>(), sgn, 1e-12);
+    EXPECT_NEAR(rim["restitution"].get<double>(), 0.5, 1e-12);
+    EXPECT_NEAR(rim["friction"].get<double>(), 0.3, 1e-12);
+    EXPECT_NEAR(rim["rolling_resistance"].get<double>(), 3e-4, 1e-15);
+  }
+  ASSERT_EQ(j["faces"].size(), 3u);
+  const char* names[] = {"heads", "tails", "edge"};
+  for (std::size_t f = 0; f < 3; ++f) {
+    EXPECT_EQ(j["faces"][f]["direction"], names[f]);
+    EXPECT_EQ(j["faces"][f]["curved"], f == 2);
+  }
+  EXPECT_EQ(j["faces"][2]["label"], 7);
+  // A polyhedron has none of it.
+  const CliRun d = cli("info scenes/paper/die1.toml --json");
+  ASSERT_EQ(d.code, 0) << d.err;
+  EXPECT_FALSE(nlohmann::json::parse(d.out).contains("cylinder"));
+}
+
 TEST(Cli, HelpTeaches) {
   const CliRun r = cli("toss --help");
   EXPECT_EQ(r.code, 0);

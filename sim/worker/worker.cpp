@@ -79,35 +79,54 @@ void WorkerCore::on_run_start(const dicesim_lcm::run_start& m, double now) {
   if (m.run_id == 0 || (cfg_.only_run != 0 && m.run_id != cfg_.only_run) || ended_runs_.count(m.run_id)) return;
   if (run_ && run_->spec.run_id == m.run_id) {
     run_->last_heard = now;
+    // Ready but never leased anything: the aggregator may not have heard the status that said so
+    // (an adopted run's worker can speak before the aggregator listens). Say it again now, not at
+    // the next heartbeat (up to 200 ms later).
+    if (run_->model && last_lease_seen_ == 0 && leases_.empty()) send_status(now);
     return;
   }
   if (run_ && now - run_->last_heard < cfg_.run_silence_s) return;  // busy with another live run
   if (run_) end_run("replaced by a newer run");
+  start_run(wire::from_message(m), nullptr, now);
+}
+
+void WorkerCore::adopt(const wire::RunSpec& spec, const DieModel& model, double now) {
+  if (spec.run_id == 0 || (cfg_.only_run != 0 && spec.run_id != cfg_.only_run) || ended_runs_.count(spec.run_id)) return;
+  if (run_) end_run("replaced by a newer run");
+  start_run(spec, &model, now);
+}
+
+void WorkerCore::start_run(wire::RunSpec spec, const DieModel* known, double now) {
+  const std::int64_t run_id = spec.run_id;
   run_ = std::make_unique<Run>();
-  run_->spec = wire::from_message(m);
-  if (cfg_.on_run) cfg_.on_run(m.run_id);
+  run_->spec = std::move(spec);
+  if (cfg_.on_run) cfg_.on_run(run_id);
   run_->last_heard = now;
   leases_.clear();
   last_lease_seen_ = last_done_ = 0;
   tosses_done_ = rate_n_ = 0;
   rate_t_ = now;
+  const wire::RunSpec& s = run_->spec;
   try {
-    if (m.total_tosses <= 0 || m.seed < 0) throw std::runtime_error("total_tosses and seed must be positive");
-    DieModel model = wire::compile_spec(run_->spec);
-    if (wire::model_fingerprint(model) != run_->spec.fingerprint)
+    if (s.total == 0 || s.total > static_cast<std::uint64_t>(INT64_MAX) || s.seed > static_cast<std::uint64_t>(INT64_MAX))
+      throw std::runtime_error("total_tosses and seed must be positive");
+    // A model handed over in memory is used only if it is exactly the one the spec describes.
+    const bool use_known = known && wire::model_fingerprint(*known) == s.fingerprint && known->outcome_labels == s.labels;
+    DieModel model = use_known ? *known : wire::compile_spec(s);
+    if (!use_known && wire::model_fingerprint(model) != s.fingerprint)
       throw std::runtime_error("the model compiled here differs from the aggregator's (fingerprint mismatch: "
                                "a different dicesim build?)");
     // Results go out as indices into run_start's outcome list: it must be this model's.
-    if (model.outcome_labels != run_->spec.labels)
+    if (model.outcome_labels != s.labels)
       throw std::runtime_error("the die compiled here has other outcome labels than run_start announces");
     run_->model = std::move(model);
   } catch (const std::exception& e) {  // SceneError or anything else: refuse, say why
     run_->error = e.what();
   }
   if (cfg_.log)
-    cfg_.log(run_->model ? "run " + std::to_string(m.run_id) + ": " + m.origin + ", " + std::to_string(m.total_tosses) +
-                               " tosses, seed " + std::to_string(m.seed)
-                         : "refusing run " + std::to_string(m.run_id) + ": " + run_->error);
+    cfg_.log(run_->model ? "run " + std::to_string(run_id) + ": " + s.origin + ", " + std::to_string(s.total) +
+                               " tosses, seed " + std::to_string(s.seed)
+                         : "refusing run " + std::to_string(run_id) + ": " + run_->error);
   send_status(now);
 }
 
@@ -277,6 +296,8 @@ int run_worker(const WorkerOptions& opt) {
   Inbox inbox{&core, t0};
   for (const char* ch : {wire::kRunStart, wire::kWorkLease, wire::kProbabilities})
     bus.subscribe(ch, &Inbox::handle, &inbox)->setQueueCapacity(4096);
+  // After subscribing: adopt's status brings leases at once, which must not go unheard.
+  if (opt.known_spec && opt.known_model) core.adopt(*opt.known_spec, *opt.known_model, 0.0);
   if (opt.core.log) opt.core.log("worker " + std::to_string(core.id()) + " listening on " + opt.url);
   for (;;) {
     if (opt.cancel && opt.cancel->load()) break;

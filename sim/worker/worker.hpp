@@ -25,7 +25,7 @@ namespace dicesim::worker {
 struct WorkerConfig {
   std::int64_t worker_id = 0;        // 0: pick a random one
   std::int64_t only_run = 0;         // non-zero: serve only this run id
-  int batch = 1024;                  // tosses per toss_batch (<= wire::kMaxBatch)
+  int batch = wire::kMaxBatch;       // tosses per toss_batch: the most a message holds (fewer wake-ups)
   double heartbeat_s = 0.2;
   double run_silence_s = 5.0;        // no run_start for this long: the run is gone
   double max_trace_per_s = 2000.0;   // bounce_state messages per second at most (publishers pace themselves)
@@ -42,6 +42,11 @@ class WorkerCore {
   WorkerCore(WorkerConfig cfg, Send send);
 
   void on_message(std::string_view channel, const void* data, std::size_t len, double now);
+  // Serve `spec` at once with `model`, as if its run_start had just been heard and compiled: for a
+  // local worker that `dicesim run` forked after compiling the run itself (no wait for run_start,
+  // no second compile). The model must be the spec's (fingerprint and labels; else it is compiled
+  // from the spec as usual). Tells the aggregator at once that it is ready.
+  void adopt(const wire::RunSpec& spec, const DieModel& model, double now);
   // Heartbeats and run expiry. Call often (every batch and every idle wait).
   void tick(double now);
   // Simulates and publishes one batch of the current lease; false when there is nothing to do.
@@ -67,6 +72,8 @@ class WorkerCore {
   };
 
   void on_run_start(const dicesim_lcm::run_start& m, double now);
+  // Takes up `spec` (run_start's, or adopt's); `known`: its model, already compiled (else compiled here).
+  void start_run(wire::RunSpec spec, const DieModel* known, double now);
   void on_lease(const dicesim_lcm::work_lease& m);
   // `final`: the run is over for good (finished, replaced); otherwise (its aggregator went
   // silent) the same run may be served again when its run_start comes back (a resumed aggregator).
@@ -95,6 +102,9 @@ class WorkerCore {
 struct WorkerOptions {
   std::string url;                            // resolved
   WorkerConfig core;
+  // Both set: serve this run from the start (WorkerCore::adopt), without waiting for its run_start.
+  const wire::RunSpec* known_spec = nullptr;
+  const DieModel* known_model = nullptr;
   bool once = false;                          // exit after the first run it served ends
   const std::atomic<bool>* cancel = nullptr;  // set from a signal handler
 };

@@ -135,10 +135,12 @@ case "$scenario" in
   run_cmd)
     reference
     url="udpm://239.255.76.67:$((30000 + $$ % 20000))?ttl=0"
-    "$bin" run "$scene" --workers 2 --tosses "$n" --seed "$seed" --json --lcm "$url" > "$work/out.json" 2> "$work/run.err" ||
-      fail "dicesim run exited $?"
+    "$bin" run "$scene" --workers 2 --tosses "$n" --seed "$seed" --json --lcm "$url" --log-level debug > "$work/out.json" \
+      2> "$work/run.err" || fail "dicesim run exited $?"
     same_as_reference "$work/out.json"
     grep -q '"threads":2' "$work/out.json" || fail "threads should report the 2 workers"
+    # Its workers are forks that start with the run's compiled model, not exec'd processes.
+    [ "$(grep -c "forked by .dicesim run. (no exec)" "$work/run.err")" = 2 ] || fail "run's workers were not forked without exec"
     sleep 0.2
     if pgrep -f -- "--lcm $url" > /dev/null; then fail "worker processes left behind"; fi
     ;;
