@@ -16,6 +16,12 @@
 // 2e-10) moved one toss's face on each of Die 2, Die 3 and the fair die (of 100) and the bounces by
 // +3 / -8 / +5 / +5; the agreement check (20 000 Die 1 tosses against `impulse`) is unchanged:
 // chi-square p 0.585 -> 0.594, largest face difference +0.0060 -> +0.0059, both inside 95%.
+// The lever arms of a multi-point solve in one contact plane when its points lie within 1e-6 r of each other
+// (sim/dynamics/friction_impact.cpp: touching corners differ in height by up to the touch
+// tolerance, which made some faces' problems inconsistent and their solves unconverged on Die 3
+// and the prisms) changed `impulse`'s bounces on Die 1 (44321 -> 44320) and the fair die (42470 ->
+// 42473), `stepped`'s on Die 3 (1983 -> 1984); no face. Merged with the closed-form flights above:
+// `stepped` bounces 2026 / 2145 / 1988 / 2086 -> 2025 / 2147 / 1989 / 2086, no face.
 #include <gtest/gtest.h>
 
 #include "fidelity_test_util.hpp"
@@ -29,19 +35,19 @@ using dicesim::testing::Golden;
 
 TEST(ImpulseRegression, CountsArePinned) {
   const Golden golden[] = {
-      {"scenes/paper/die1.toml", {298, 307, 288, 308, 194, 605}, 44321, {0, 0, 0, 0}},
+      {"scenes/paper/die1.toml", {298, 307, 288, 308, 194, 605}, 44320, {0, 0, 0, 0}},
       {"scenes/paper/die2.toml", {361, 296, 325, 303, 286, 429}, 43858, {0, 0, 0, 0}},
       {"scenes/paper/die3.toml", {200, 462, 304, 322, 479, 233}, 44995, {0, 0, 0, 0}},
-      {"scenes/fair.toml", {319, 332, 347, 338, 308, 356}, 42470, {0, 0, 0, 0}},
+      {"scenes/fair.toml", {319, 332, 347, 338, 308, 356}, 42473, {0, 0, 0, 0}},
   };
   for (const Golden& g : golden) check_pinned(g, Fidelity::Impulse, 2000);
 }
 
 TEST(SteppedRegression, CountsArePinned) {
   const Golden golden[] = {
-      {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2026, {0, 0, 0, 0}},
-      {"scenes/paper/die2.toml", {15, 15, 21, 16, 16, 17}, 2145, {0, 0, 0, 0}},
-      {"scenes/paper/die3.toml", {14, 19, 14, 22, 21, 10}, 1988, {0, 0, 0, 0}},
+      {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2025, {0, 0, 0, 0}},
+      {"scenes/paper/die2.toml", {15, 15, 21, 16, 16, 17}, 2147, {0, 0, 0, 0}},
+      {"scenes/paper/die3.toml", {14, 19, 14, 22, 21, 10}, 1989, {0, 0, 0, 0}},
       {"scenes/fair.toml", {14, 16, 14, 15, 25, 16}, 2086, {0, 0, 0, 0}},
   };
   for (const Golden& g : golden) check_pinned(g, Fidelity::Stepped, 100);

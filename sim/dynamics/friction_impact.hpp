@@ -12,7 +12,10 @@
 //     every sweep lowers the energy; warm-started, symmetric sweeps, converged to 1e-11 of the
 //     speeds; a solve still unconverged at the sweep cap (an edge near the stick-slip boundary:
 //     two corners' compliance has rank 5) is finished by semismooth Newton on the Alart-Curnier
-//     equations, and counted (pgs_unconverged) only if that fails too.
+//     equations, and counted (pgs_unconverged) only if that fails too. The lever arms of a
+//     multi-point solve lie in one contact plane (the lowest point's height) when its points are
+//     within 1e-6 r of it: corners touching within the tolerance but out of level by ~1e-9 m
+//     made a face's problem inconsistent.
 //  2. Restitution, energetic (Stronge): the normal impulses of compression, scaled by one k,
 //     release e^2 times the energy compression stored in the normal direction, where that is
 //     E_c = min(-W_n, -dE_c): W_n the work of the normal impulses along the compression (straight
