@@ -18,7 +18,7 @@ namespace {
 using namespace dicesim;
 
 ContactSearch reference_search(const DieModel& m, const RigidState& s, double t_limit) {
-  const TorqueFreeRotation rot(m.principal_moments, s.R, world_inertia(m, s.R) * s.omega);
+  const TorqueFreeRotation rot(m.principal_moments, s.R, world_angular_momentum(m, s.R, s.omega));
   const double g = m.gravity, r = m.bounding_radius;
   const double w_max = rot.max_omega();
   const double A = g + r * (w_max * w_max + rot.max_alpha());

@@ -63,7 +63,8 @@ Flight::Flight(const DieModel& model, const RigidState& s)
     : model_(&model),
       p0_(s.position),
       v0_(s.velocity),
-      rotation_(model.principal_moments, s.R, world_inertia(model, s.R) * s.omega) {
+      // R (I * (R^T omega)): 21 products where R diag(I) R^T omega took 54.
+      rotation_(model.principal_moments, s.R, world_angular_momentum(model, s.R, s.omega)) {
   const double r = model.bounding_radius;
   // z_i'' = -g + (alpha x p + omega x (omega x p))_z, so |z_i'' + g| <= r (|omega|^2 + |alpha|).
   const double w = rotation_.max_omega();

@@ -66,6 +66,11 @@ inline double corner_height(const DieModel& m, const RigidState& s, int v) {
   return s.position.z() + s.R.row(2).dot(m.vertices[static_cast<std::size_t>(v)]) - m.rounding;
 }
 
+// World angular momentum R diag(I) R^T omega, evaluated as R (I * (R^T omega)) (what Flight uses).
+inline Vec3 world_angular_momentum(const DieModel& m, const Mat3& R, const Vec3& omega) {
+  return R * m.principal_moments.cwiseProduct(R.transpose() * omega);
+}
+
 // World inertia tensor of the die at orientation R: R diag(I) R^T.
 inline Mat3 world_inertia(const DieModel& m, const Mat3& R) {
   return R * m.principal_moments.asDiagonal() * R.transpose();

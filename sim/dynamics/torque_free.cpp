@@ -46,6 +46,8 @@
 #include <boost/math/policies/policy.hpp>
 #include <boost/math/special_functions/ellint_rf.hpp>
 
+#include "sim/sincos.hpp"
+
 namespace dicesim {
 namespace {
 
@@ -134,15 +136,15 @@ TorqueFreeRotation::TorqueFreeRotation(const Vec3& moments, const Mat3& R0, cons
     return;
   }
   const Vec3 L_body = R0_.transpose() * L_;
-  if (!is_symmetric_top(I_)) {
+  const bool e01 = nearly_equal(I_[0], I_[1]), e12 = nearly_equal(I_[1], I_[2]),
+             e02 = nearly_equal(I_[0], I_[2]);
+  if (!(e01 || e12 || e02)) {  // not is_symmetric_top(I_)
     kind_ = Kind::General;
     init_general(L_body);
     return;
   }
   kind_ = Kind::SymmetricTop;
   const Vec3 a = I_.cwiseInverse();
-  const bool e01 = nearly_equal(I_[0], I_[1]), e12 = nearly_equal(I_[1], I_[2]),
-             e02 = nearly_equal(I_[0], I_[2]);
   if (int(e01) + int(e12) + int(e02) >= 2) {
     // A sphere (all three agree): pure rotation about L at |L|/I; the axis choice is immaterial.
     const double a_mean = a.sum() / 3.0;
@@ -169,9 +171,7 @@ void TorqueFreeRotation::init_symmetric(int axis, double inv_I_axis, double inv_
   // Rodrigues: Rot(n, alpha) = n n^T + cos(alpha) (1 - n n^T) + sin(alpha) [n]x, applied to R0 once here.
   s.along = L_hat * (L_hat.transpose() * R0_);
   s.across = R0_ - s.along;
-  Mat3 n_cross;
-  n_cross << 0.0, -L_hat.z(), L_hat.y(), L_hat.z(), 0.0, -L_hat.x(), -L_hat.y(), L_hat.x(), 0.0;
-  s.cross = n_cross * R0_;
+  for (int j = 0; j < 3; ++j) s.cross.col(j) = L_hat.cross(R0_.col(j));  // [L^]x R0
 
   // |omega| and |alpha| are constant in regular precession: omega_world = a_perp L + spin_rate R e_a,
   // d(R e_a)/dt = a_perp L x R e_a, so |alpha| = |spin_rate| a_perp |L x e_a| = |spin_rate| a_perp L_perp.
@@ -179,7 +179,7 @@ void TorqueFreeRotation::init_symmetric(int axis, double inv_I_axis, double inv_
   const double L_perp = std::sqrt(sq(L_body[s.p]) + sq(L_body[s.q]));
   const double omega = std::sqrt(sq(inv_I_perp * L_perp) + sq(inv_I_axis * L_axis));
   const double alpha = std::abs(s.spin_rate) * inv_I_perp * L_perp;
-  const double a_max = I_.cwiseInverse().maxCoeff();
+  const double a_max = 1.0 / I_.minCoeff();  // = max_i 1/I_i exactly: division is monotone
   max_omega_ = omega * (1.0 + kBoundMargin);
   max_alpha_ = alpha * (1.0 + kBoundMargin) + kBoundMargin * a_max * L_norm * max_omega_;
 }
@@ -336,8 +336,8 @@ TorqueFreeRotation::JacobiState TorqueFreeRotation::jacobi_state(double t) const
   const double half_periods = std::nearbyint(u * g.inv_two_K);
   const double r = std::fma(-g.two_K, half_periods, u);
   // Ascending through the Landen ladder from sn = sin, cn = cos, dn = 1 at the negligible modulus.
-  const double v = r * g.landen_scale;
-  double sn = std::sin(v), cn = std::cos(v), dn = 1.0;
+  const SinCos scv = sincos(r * g.landen_scale);
+  double sn = scv.sin, cn = scv.cos, dn = 1.0;
   for (int n = g.landen_levels - 1; n >= 0; --n) {
     const double k = g.landen_k[n];
     const double inv_den = 1.0 / (1.0 + k * sn * sn);
@@ -360,11 +360,11 @@ TorqueFreeRotation::JacobiState TorqueFreeRotation::jacobi_state(double t) const
 
 Mat3 TorqueFreeRotation::symmetric_orientation(double t) const {
   const Symmetric& s = sym_;
-  const double alpha = s.precession_rate * t;
-  Mat3 R = s.along + std::cos(alpha) * s.across + std::sin(alpha) * s.cross;
+  SinCos a, b;  // both angles in one SSE2 pass: the same numbers as two sincos calls
+  sincos2(s.precession_rate * t, s.spin_rate * t, a, b);
+  Mat3 R = s.along + a.cos * s.across + a.sin * s.cross;
   if (s.spin_rate != 0.0) {
-    const double beta = s.spin_rate * t;
-    const double cb = std::cos(beta), sb = std::sin(beta);
+    const double cb = b.cos, sb = b.sin;
     const Vec3 col_p = R.col(s.p), col_q = R.col(s.q);
     R.col(s.p) = cb * col_p + sb * col_q;
     R.col(s.q) = cb * col_q - sb * col_p;
@@ -393,7 +393,8 @@ Mat3 TorqueFreeRotation::general_orientation(const JacobiState& js, double t, Ve
   B.col(g.y) << -sin_psi, cos_theta * cos_psi, sin_theta * cos_psi;
   B.col(g.d) << 0.0, -sin_theta, cos_theta;
   const double dphi = g.phi_rate * t - g.phi_coeff * (js.f - g.f0);
-  const double cp = std::cos(dphi), sp = std::sin(dphi);
+  const SinCos p = sincos(dphi);
+  const double cp = p.cos, sp = p.sin;
   Mat3 M;
   M.row(0) = cp * B.row(0) - sp * B.row(1);
   M.row(1) = sp * B.row(0) + cp * B.row(1);
@@ -411,12 +412,11 @@ Vec3 TorqueFreeRotation::bottom_row(double t) const {
   if (kind_ == Kind::General && !gen_.steady) return orientation(t).row(2).transpose();
   // symmetric_orientation, row 2 only.
   const Symmetric& s = sym_;
-  const double alpha = s.precession_rate * t;
-  Vec3 r = s.along.row(2).transpose() + std::cos(alpha) * s.across.row(2).transpose() +
-           std::sin(alpha) * s.cross.row(2).transpose();
+  SinCos a, b;
+  sincos2(s.precession_rate * t, s.spin_rate * t, a, b);
+  Vec3 r = s.along.row(2).transpose() + a.cos * s.across.row(2).transpose() + a.sin * s.cross.row(2).transpose();
   if (s.spin_rate != 0.0) {
-    const double beta = s.spin_rate * t;
-    const double cb = std::cos(beta), sb = std::sin(beta);
+    const double cb = b.cos, sb = b.sin;
     const double rp = r(s.p), rq = r(s.q);
     r(s.p) = cb * rp + sb * rq;
     r(s.q) = cb * rq - sb * rp;

@@ -76,8 +76,10 @@ class TorqueFreeRotation {
     // Descending Landen transformation (A&S 16.12) from k down to a negligible modulus.
     int landen_levels = 0;
     double landen_scale = 1;             // prod 1 / (1 + k_n): sn(u|k) from sin(u * scale)
-    double landen_k[kMaxLandenLevels] = {};          // k_n, n = 1..levels
-    double landen_one_minus_k[kMaxLandenLevels] = {};  // 1 - k_n, accurate near k_n = 1
+    // k_n and 1 - k_n (accurate near k_n = 1), n = 1..levels; entries past `landen_levels` are
+    // never read, and left uninitialised: a rotation is set up per flight and per trial step.
+    double landen_k[kMaxLandenLevels];
+    double landen_one_minus_k[kMaxLandenLevels];
   } gen_;
 
   struct JacobiState {

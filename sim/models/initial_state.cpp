@@ -3,21 +3,24 @@
 #include <cmath>
 
 #include "sim/models/toss_random.hpp"
+#include "sim/sincos.hpp"
 
 namespace dicesim {
 
 Mat3 uniform_rotation(double u1, double u2, double u3) {
   const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
-  const double t2 = 2.0 * kPi * u2, t3 = 2.0 * kPi * u3;
-  Quat q(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2), b * std::sin(t3));  // (w, x, y, z)
-  return q.normalized().toRotationMatrix();
+  const SinCos t2 = sincos_turns(u2), t3 = sincos_turns(u3);  // angles 2 pi u2, 2 pi u3
+  // A unit quaternion to rounding (a^2 + b^2 = 1, cos^2 + sin^2 = 1): normalising again would
+  // change only the last bits, at the cost of a square root and four divisions.
+  const Quat q(b * t3.cos, a * t2.sin, a * t2.cos, b * t3.sin);  // (w, x, y, z)
+  return q.toRotationMatrix();
 }
 
 Vec3 uniform_unit_vector(double u1, double u2) {
   const double z = 2.0 * u1 - 1.0;
   const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-  const double a = 2.0 * kPi * u2;
-  return {r * std::cos(a), r * std::sin(a), z};
+  const SinCos a = sincos_turns(u2);
+  return {r * a.cos, r * a.sin, z};
 }
 
 static double draw(TossRandom& rng, const NormalScalar& d) {
@@ -71,8 +74,8 @@ InitialState draw_initial_state(const ThrowDef& thr, std::uint64_t seed, std::ui
       const Vec3 a = thr.spin.axis.normalized();
       const Vec3 e1 = a.unitOrthogonal(), e2 = a.cross(e1);
       const double tilt = draw(rng, thr.spin.tilt_deg) * (kPi / 180.0);
-      const double az = 2.0 * kPi * rng.uniform();
-      const Vec3 dir = std::cos(tilt) * a + std::sin(tilt) * (std::cos(az) * e1 + std::sin(az) * e2);
+      const SinCos tl = sincos(tilt), az = sincos_turns(rng.uniform());  // azimuth 2 pi u
+      const Vec3 dir = tl.cos * a + tl.sin * (az.cos * e1 + az.sin * e2);
       s.omega = s.orientation * dir * draw(rng, thr.spin.magnitude);
       break;
     }

@@ -9,6 +9,7 @@
 #include <cstdint>
 
 #include "sim/math.hpp"
+#include "sim/sincos.hpp"
 
 namespace dicesim {
 
@@ -33,10 +34,10 @@ class TossRandom {
       return spare_;
     }
     const double r = std::sqrt(-2.0 * std::log(uniform()));
-    const double a = 2.0 * kPi * uniform();
-    spare_ = r * std::sin(a);
+    const SinCos a = sincos_turns(uniform());  // the angle 2 pi u
+    spare_ = r * a.sin;
     has_spare_ = true;
-    return r * std::cos(a);
+    return r * a.cos;
   }
 
  private:
