@@ -318,6 +318,28 @@ TEST(CylinderPaperAndStepped, TossesSettleAndReadTheRimsModel) {
 
 // Rest soundness: when `impulse` says settled, continued contact dynamics never name another
 // outcome (the energy is below the saddle out of its basin, and stays so).
+// A coin lying flat on its tails face (axis down: face 1), sliding at 1 m/s: far above every
+// barrier, yet it cannot turn over (rest.hpp's argument); the rule says so at once (the energy
+// gate used to bar it), and stepping on keeps it on that face.
+TEST(CylinderImpulse, LyingFlatDecidesWhateverTheSlidingSpeed) {
+  const DieModel m = coin_model(0.012, 0.002, "[sim]\nfidelity = \"impulse\"\n");
+  RigidState s;
+  s.R = Eigen::Quaterniond::FromTwoVectors(m.rims.axis, Vec3::UnitZ()).toRotationMatrix();  // heads up
+  s.position = Vec3(0.0, 0.0, -rim_lowest(m, s.R));
+  s.velocity = Vec3(1.0, 0.0, 0.0);
+  s.omega = Vec3(0.0, 0.0, 5.0);
+  const Vec3 wb = s.R.transpose() * s.omega;
+  const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
+  ASSERT_GE(ke + m.mass * m.gravity * s.position.z(), m.mass * m.gravity * m.max_escape);
+  EXPECT_EQ(rest_face_down(m, s, 0.5), 1);
+  FixedStepper st(m, 5e-4);
+  for (int k = 1; k <= 1000; ++k) {
+    st.step(s);
+    if (k % 100 == 0) ASSERT_EQ(rim_quasi_static_down(m, s.R, 0.5), 1) << "step " << k;
+  }
+  EXPECT_EQ(rest_face_down(m, s, 0.5), 1);
+}
+
 TEST(CylinderImpulse, RestIsSound) {
   SoftTable soft;
   const DieModel m = coin_model(0.01, 0.012, std::string(kTable) + "[sim]\nfidelity = \"impulse\"\n");

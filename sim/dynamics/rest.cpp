@@ -227,40 +227,52 @@ int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) {
   const Vec3 wb = s.R.transpose() * s.omega;
   const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
   const double mg = m.mass * m.gravity;
-  if (ke + mg * s.position.z() >= mg * m.max_escape) return -1;  // cheap: no basin can hold it yet
+  // Energy above every basin's barrier and no corner can reach the floor: neither criterion can
+  // hold (cheap; the flights' and the air steps' rest checks end here).
+  const bool above_barriers = ke + mg * s.position.z() >= mg * m.max_escape;
+  if (above_barriers && s.position.z() > m.bounding_radius) return -1;
 
   double low = kInf;
   for (const Vec3& v : m.vertices) low = std::min(low, s.R.row(2).dot(v));
   low += s.position.z() - m.rounding;
-  const double energy = ke + mg * (s.position.z() + std::max(0.0, -low));
 
-  // Lying flat on the face most nearly down, sliding or spinning but not rocking.
-  int down = 0;
-  double down_z = 2.0;
-  const int nf = m.face_count();
-  for (int f = 0; f < nf; ++f) {
-    const double z = s.R.row(2).dot(m.face_normals[static_cast<std::size_t>(f)]);
-    if (z < down_z) {
-      down_z = z;
-      down = f;
-    }
-  }
-  const std::size_t di = static_cast<std::size_t>(down);
+  // Lying flat on the face most nearly down, sliding or spinning but not rocking. Whatever its
+  // kinetic energy (rest.hpp): the energy gate above must not decide this one.
   const double flat_tol = 1e-6 * m.bounding_radius;
-  const double v_tol = 1e-3 * std::sqrt(m.gravity * m.bounding_radius);
-  const double spin = s.omega.z();
-  if (low <= flat_tol && m.max_friction < 0.999 * m.face_tip_ratio[di] && down_z < -0.999 &&
-      spin * spin * m.face_gyro[di] < 0.999 * mg * m.face_hold[di]) {
-    bool flat = true;
-    for (const int v : m.face_vertices(down)) {
-      if (!flat) break;
-      const Vec3 r = s.R * m.vertices[static_cast<std::size_t>(v)];
-      flat = s.position.z() + r.z() - m.rounding - std::min(low, 0.0) <= flat_tol &&
-             std::abs((s.velocity + s.omega.cross(r)).z()) <= v_tol;
+  if (low <= flat_tol) {
+    int down = 0;
+    double down_z = 2.0;
+    const int nf = m.face_count();
+    for (int f = 0; f < nf; ++f) {
+      const double z = s.R.row(2).dot(m.face_normals[static_cast<std::size_t>(f)]);
+      if (z < down_z) {
+        down_z = z;
+        down = f;
+      }
     }
-    if (flat) return down;
+    const std::size_t di = static_cast<std::size_t>(down);
+    const double v_tol = 1e-3 * std::sqrt(m.gravity * m.bounding_radius);
+    // The largest spin the flat motion can ever reach: all of its kinetic energy (friction only
+    // removes it) in the spin about the face's normal n, w^2 <= 2 ke / (n . I n).
+    const Vec3& n = m.face_normals[di];
+    const double spin_max2 = 2.0 * ke / n.dot(m.principal_moments.cwiseProduct(n));
+    // Friction shifts the centre of pressure needed by at most mu h, the gyroscopic torque by
+    // w^2 |n x I n| / (m g): together within face_hold (rest.hpp).
+    if (down_z < -0.999 && m.face_hold[di] > 0.0 &&
+        m.max_friction * m.face_height[di] + spin_max2 * m.face_gyro[di] / mg < 0.999 * m.face_hold[di]) {
+      bool flat = true;
+      for (const int v : m.face_vertices(down)) {
+        if (!flat) break;
+        const Vec3 r = s.R * m.vertices[static_cast<std::size_t>(v)];
+        flat = s.position.z() + r.z() - m.rounding - std::min(low, 0.0) <= flat_tol &&
+               std::abs((s.velocity + s.omega.cross(r)).z()) <= v_tol;
+      }
+      if (flat) return down;
+    }
   }
 
+  if (above_barriers) return -1;
+  const double energy = ke + mg * (s.position.z() + std::max(0.0, -low));
   const int basin = quasi_static_down_face(m, s.R, tiebreak);
   if (basin >= 0 && energy < mg * m.face_escape[static_cast<std::size_t>(basin)] * (1.0 - 1e-9)) return basin;
   return -1;

@@ -41,9 +41,25 @@ int roll_from_face(const DieModel& m, int f, double tiebreak);
 //  - energy: E < m g face_escape[A] with A = the basin of R (above); or
 //  - lying flat: every corner of the face most nearly down, A, on the floor with vanishing normal
 //    velocity; every corner's friction below face_tip_ratio[A], so friction cannot tip it while it
-//    slides or spins; and the spin w about the vertical small enough that the torque keeping a
-//    non-principal axis upright, w^2 |n x I n|, is within what gravity holds, m g face_hold[A]
-//    (beyond that the spinning die lifts an edge). A face that cannot hold the COM never qualifies.
+//    slides or spins; and the largest spin w about the vertical that the flat motion can ever
+//    reach (all its kinetic energy in that spin, w^2 <= 2 KE / (n . I n)) small enough that the
+//    torque keeping a non-principal axis upright, w^2 |n x I n|, is within what gravity holds,
+//    m g face_hold[A] (beyond that the spinning die lifts an edge); the two together: friction's
+//    and the spin's shifts of the centre of pressure, mu h and w^2 |n x I n| / (m g), add up to
+//    less than face_hold[A]. A face that cannot hold the COM never qualifies. This one holds WHATEVER the kinetic energy (the die may slide at any speed):
+//    lying flat, the contact forces that keep the face down exist and obey Coulomb's law. With c_i
+//    the corners relative to the COM's foot, u_i their slip directions (any, for a sticking one)
+//    and weights w_i = N_i / N >= 0 summing to 1, the horizontal torque about the COM vanishes
+//    iff sum w_i (c_i - h mu u_i) = 0 (friction acts at the floor, depth h below the COM, so its
+//    torque is h times the total friction, at most mu N h): the foot must lie in the convex hull
+//    of the points c_i moved by at most mu h. The disc of radius face_hold around the foot lies in
+//    the face, so the hull's support in every direction exceeds the foot's by at least
+//    face_hold - mu h > 0: the foot is inside, nonnegative N_i exist, and no corner needs to
+//    lift. The flat motion does no work against gravity and friction only removes kinetic
+//    energy, so the spin bound holds ever after, and the die stops on A. (Until this revision a
+//    cheap energy gate, E >= m g max_escape => undecided, ran first and also barred this rule: a
+//    Die 1 `impulse` toss spent 11.6 of its 63 contact steps sliding flat on a face, already
+//    decided. The gate now only ends the check when no corner can reach the floor either.)
 int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak);
 
 // The face that is read when face f lies on the floor (the face up, or f for a die read down).

@@ -86,25 +86,31 @@ int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) 
   const Vec3 wb = s.R.transpose() * s.omega;
   const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
   const double mg = m.mass * m.gravity;
-  if (ke + mg * s.position.z() >= mg * m.max_escape) return -1;
+  // Above every barrier: only lying flat can decide, and only with a rim point on the floor.
+  const bool above_barriers = ke + mg * s.position.z() >= mg * m.max_escape;
+  if (above_barriers && s.position.z() > m.bounding_radius) return -1;
   const double low = s.position.z() + rim_lowest(m, s.R);
-  const double energy = ke + mg * (s.position.z() + std::max(0.0, -low));
-  const int basin = rim_quasi_static_down(m, s.R, tiebreak);
-  if (basin >= 0 && energy < mg * m.face_escape[static_cast<std::size_t>(basin)] * (1.0 - 1e-9)) return basin;
+  if (!above_barriers) {
+    const double energy = ke + mg * (s.position.z() + std::max(0.0, -low));
+    const int basin = rim_quasi_static_down(m, s.R, tiebreak);
+    if (basin >= 0 && energy < mg * m.face_escape[static_cast<std::size_t>(basin)] * (1.0 - 1e-9)) return basin;
+  }
 
-  // Lying flat on a face, sliding or spinning but not rocking (as a polytope's face, rest.hpp):
-  // the face's tripod on the floor with vanishing normal velocity, friction too weak to tip it
-  // (mu below face_tip_ratio), and the spin about the vertical within what gravity holds against
-  // the gyroscopic torque w^2 |n x I n| (0 for a symmetric coin). Such a coin cannot turn over.
+  // Lying flat on a face, sliding or spinning but not rocking (as a polytope's face, rest.hpp, and
+  // like it whatever the kinetic energy): the face's tripod on the floor with vanishing normal
+  // velocity, friction's and the spin's shifts of the centre of pressure (mu h, and w^2 |n x I n|
+  // / (m g) with w the largest spin the flat motion can reach, 0 for a symmetric coin) within
+  // face_hold. Such a coin cannot turn over.
   const double kz = s.R.row(2).dot(m.rims.axis);
   if (std::abs(kz) < 0.999) return -1;
   const int down = kz < 0.0 ? 0 : 1;  // face 0 (heads face) down when the axis points down
   const std::size_t di = static_cast<std::size_t>(down);
   const double flat_tol = 1e-6 * m.bounding_radius;
   const double v_tol = 1e-3 * std::sqrt(m.gravity * m.bounding_radius);
-  const double spin = s.omega.z();
-  if (!(m.face_hold[di] >= 0.0 && m.max_friction < 0.999 * m.face_tip_ratio[di] &&
-        spin * spin * m.face_gyro[di] < 0.999 * mg * m.face_hold[di]))
+  const Vec3& n = m.rims.axis;  // body frame: the face normals are +-axis
+  const double spin_max2 = 2.0 * ke / n.dot(m.principal_moments.cwiseProduct(n));
+  if (!(m.face_hold[di] > 0.0 &&
+        m.max_friction * m.face_height[di] + spin_max2 * m.face_gyro[di] / mg < 0.999 * m.face_hold[di]))
     return -1;
   for (int j = 0; j < 3; ++j) {
     const Vec3 r = rim_point(m, s.R, 3 * down + j);
