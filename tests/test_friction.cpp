@@ -39,6 +39,17 @@ RigidState touching_state(const DieModel& m, TossRandom& rng, double spin) {
   return s;
 }
 
+// A state captured from a run as hex floats (R row-major), replayed exactly.
+RigidState replay_state(const double (&R)[9], const double (&x)[3], const double (&v)[3], const double (&w)[3]) {
+  RigidState s;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) s.R(i, j) = R[3 * i + j];
+  s.position = Vec3(x[0], x[1], x[2]);
+  s.velocity = Vec3(v[0], v[1], v[2]);
+  s.omega = Vec3(w[0], w[1], w[2]);
+  return s;
+}
+
 }  // namespace
 
 TEST(FrictionImpact, NeverCreatesEnergy) {
@@ -440,12 +451,7 @@ TEST(FrictionImpact, EdgeRestitutionFrictionStallsAreSolvedExactly) {
   };
   for (const Stalled& st : cases) {
     const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/" + st.scene));
-    RigidState s;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) s.R(i, j) = st.R[3 * i + j];
-    s.position = Vec3(st.x[0], st.x[1], st.x[2]);
-    s.velocity = Vec3(st.v[0], st.v[1], st.v[2]);
-    s.omega = Vec3(st.w[0], st.w[1], st.w[2]);
+    RigidState s = replay_state(st.R, st.x, st.v, st.w);
     ContactSet c;
     c.n = 2;
     c.vertex[0] = st.v0;
@@ -555,12 +561,7 @@ TEST(FrictionImpact, FaceCornersAtSlightlyDifferentHeightsConverge) {
   const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/paper/die3.toml"));
   for (const Face& f : cases)
     for (const bool restitution : {true, false}) {
-      RigidState s;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) s.R(i, j) = f.R[3 * i + j];
-      s.position = Vec3(f.x[0], f.x[1], f.x[2]);
-      s.velocity = Vec3(f.v_[0], f.v_[1], f.v_[2]);
-      s.omega = Vec3(f.w[0], f.w[1], f.w[2]);
+      RigidState s = replay_state(f.R, f.x, f.v_, f.w);
       ContactSet c;
       c.n = f.n;
       for (int i = 0; i < f.n; ++i) c.vertex[i] = f.v[i];
