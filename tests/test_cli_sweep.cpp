@@ -26,6 +26,17 @@ using dicesim::testing::expect_bad_input;
 CliRun cli(const std::string& args) { return dicesim::testing::run_dicesim(args); }
 std::string tmp(const std::string& name) { return dicesim::testing::unique_temp(name); }
 
+// A sweep point's faces: labels 1..n in order, their counts summing to the settled tosses.
+void expect_faces_one_to(const nlohmann::json& p, int n) {
+  ASSERT_EQ(p["faces"].size(), static_cast<std::size_t>(n));
+  int sum = 0;
+  for (int f = 0; f < n; ++f) {
+    EXPECT_EQ(p["faces"][f]["face"], f + 1);
+    sum += p["faces"][f]["count"].get<int>();
+  }
+  EXPECT_EQ(sum, p["settled"].get<int>());
+}
+
 TEST(CliSweep, JsonHasEveryPointAndFace) {
   const CliRun r = cli("sweep scenes/paper/die1.toml --param floor.restitution --values 0.2,0.8 -n 400 --seed 3 --json");
   ASSERT_EQ(r.code, 0) << r.err;
@@ -36,13 +47,7 @@ TEST(CliSweep, JsonHasEveryPointAndFace) {
   ASSERT_EQ(j["points"].size(), 2u);
   EXPECT_DOUBLE_EQ(j["points"][1]["x"].get<double>(), 0.8);
   for (const auto& p : j["points"]) {
-    ASSERT_EQ(p["faces"].size(), 6u);
-    int sum = 0;
-    for (int f = 0; f < 6; ++f) {
-      EXPECT_EQ(p["faces"][f]["face"], f + 1);
-      sum += p["faces"][f]["count"].get<int>();
-    }
-    EXPECT_EQ(sum, p["settled"].get<int>());
+    expect_faces_one_to(p, 6);
     EXPECT_EQ(p["settled"].get<int>() + p["unresolved"].get<int>() + p["invalid"].get<int>(), 400);
   }
 }
@@ -273,13 +278,7 @@ TEST(CliSweep, AD20SweepReportsEveryOutcomeInLabelOrder) {
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["points"].size(), 2u);
   for (const auto& p : j["points"]) {
-    ASSERT_EQ(p["faces"].size(), 20u);
-    int sum = 0;
-    for (int f = 0; f < 20; ++f) {
-      EXPECT_EQ(p["faces"][f]["face"], f + 1);
-      sum += p["faces"][f]["count"].get<int>();
-    }
-    EXPECT_EQ(sum, p["settled"].get<int>());
+    expect_faces_one_to(p, 20);
   }
   // The same points tossed one by one: identical counts (the sweep adds nothing of its own).
   const CliRun one = cli("toss scenes/dice/d20.toml --set floor.restitution=0.8 -n 1000 --seed 2 --json");
