@@ -45,7 +45,10 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
     const Mat3 R = t == 0.0 ? rot_start_ : rot.orientation(t);
     return p.z() + v.z() * t + rim_lowest_excluding(*m_, R, c);
   }
-  const Vec3 z_row = t == 0.0 ? Vec3(rot_start_.row(2).transpose()) : rot.bottom_row(t);
+  return lowest_flat(c, p, v, t == 0.0 ? Vec3(rot_start_.row(2).transpose()) : rot.bottom_row(t), t);
+}
+
+double FixedStepper::lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row, double t) const {
   const auto& verts = m_->vertices;
   const int nv = static_cast<int>(verts.size());
   double low = std::numeric_limits<double>::infinity();
@@ -69,11 +72,11 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   if (impact_) a.imp = imp_;
   a.next.n = 0;
   s.velocity.z() -= m.gravity * d;
-  if (c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next);
+  if (c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
   if (m.curved() && c.n > 0) apply_rolling_resistance(m, s, c, a.sup.normal_impulse);
 
   // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact).
-  const Vec3 L = world_inertia(m, s.R) * s.omega;
+  const Vec3 L = Iw_start_ * s.omega;  // s.R is s0.R in every trial
   // Built in place (the full step's is kept for model_G; the object is large, so no copies).
   const TorqueFreeRotation& rot = (full ? full_rot_ : trial_rot_).emplace(m.principal_moments, s.R, L);
   rot_start_ = s.R;
@@ -84,25 +87,36 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   // search, which needs G's value, never starts from such a step). Most of `stepped`'s steps are
   // in the air: this skips their corner heights (and the rotation's evaluation for them).
   const double clear = p.z() + v.z() * d - (1.0 + 1e-9) * m.bounding_radius;
-  a.G = full && clear > 0.0 ? clear : lowest_new(c, p, v, rot, d);
+  // The step's end orientation is evaluated once: its bottom row is bit for bit the one
+  // bottom_row(d) returns (the same operations on the same row), so a flat die's corner heights
+  // come from it (a curved die's rim, and d = 0, keep lowest_new's own evaluation).
+  Mat3 R_end;
+  Vec3 w;
+  rot.state(d, R_end, w);
+  if (full && clear > 0.0)
+    a.G = clear;
+  else if (m.curved() || d == 0.0)
+    a.G = lowest_new(c, p, v, rot, d);
+  else
+    a.G = lowest_flat(c, p, v, R_end.row(2).transpose(), d);
   if (full) {
     full_p_ = p;
     full_v_ = v;
   }
   s.position = p + d * v;
-  Vec3 w;
-  rot.state(d, s.R, w);
+  s.R = R_end;
   s.omega = w;
 }
 
-double FixedStepper::model_root(const ContactSet& c, double miss, double lo, double hi) const {
-  double f_lo = corrected_G(c, miss, lo), f_hi = corrected_G(c, miss, hi);
+double FixedStepper::model_root(const ContactSet& c, double miss, double lo, double hi, double f_lo, double f_hi,
+                                double& g_model) const {
   int side = 0;
   double mid = hi;
   for (int it = 0; it < 100 && hi - lo > 1e-15 * h_; ++it) {
     mid = hi - f_hi * (hi - lo) / (f_hi - f_lo);
     if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
-    const double f = corrected_G(c, miss, mid);
+    g_model = model_G(c, mid);
+    const double f = corrected(g_model, miss, mid);
     if (std::abs(f) <= 1e-3 * touch_tol_) break;
     if (f > 0.0) {
       lo = mid, f_lo = f;
@@ -174,11 +188,13 @@ int FixedStepper::step(RigidState& s) {
   // trial step.
   RigidState s0 = s;
   impact_ = false;
+  geo_.valid = false;  // every solve of this step (its impact, each trial) shares s0.R and c
+  Iw_start_ = world_inertia(m, s0.R);
   if (c.n > 0) {
     double un = 0.0;
     for (int i = 0; i < c.n; ++i) un = std::min(un, corner_velocity(m, s0, c.vertex[i]).z());
     impact_ = un < -(v_impact_ + v_spin_ * s0.omega.squaredNorm());
-    if (impact_) imp_ = apply_friction_impact(m, s0, c, /*restitution=*/true);
+    if (impact_) imp_ = apply_friction_impact(m, s0, c, /*restitution=*/true, nullptr, nullptr, &geo_);
   }
   try_step(s0, c, h_, a_, /*full=*/true);
   const Attempt* done = &a_;
@@ -207,8 +223,17 @@ int FixedStepper::step(RigidState& s) {
       }
     }
     double d_lo = 0.0, d_hi = h_, g_hi = a_.G;
-    bool modelled = model_G(c, 0.0) > 0.0;
-    double d = modelled ? model_root(c, 0.0, 0.0, h_) : 0.5 * h_;
+    // The model's values at d_lo, d_hi and the next trial's d, each evaluated once (the model is a
+    // fixed function during the search: the full step's motion).
+    double mg_lo = model_G(c, 0.0), mg_hi = 0.0, mg_d = 0.0;
+    bool modelled = mg_lo > 0.0, have_mg_d = false;
+    double d = 0.5 * h_;
+    if (modelled) {
+      mg_hi = model_G(c, h_);
+      mg_d = mg_hi;
+      d = model_root(c, 0.0, 0.0, h_, corrected(mg_lo, 0.0, 0.0), corrected(mg_hi, 0.0, h_), mg_d);
+      have_mg_d = true;
+    }
     bool have_lo = false;
     int side = 0;
     done = nullptr;
@@ -222,21 +247,28 @@ int FixedStepper::step(RigidState& s) {
         break;
       }
       const double span = d * (h_ - d);
-      const double miss = span > 0.0 ? (trial->G - model_G(c, d)) / span : 0.0;
+      const double mgd = have_mg_d ? mg_d : model_G(c, d);
+      have_mg_d = false;
+      const double miss = span > 0.0 ? (trial->G - mgd) / span : 0.0;
       const bool above = trial->G > 0.0;
       if (above) {
-        d_lo = d, g_lo = trial->G;
+        d_lo = d, g_lo = trial->G, mg_lo = mgd;
         std::swap(trial, lo);  // the attempts are large: swap who is which, not their contents
         have_lo = true;
       } else {
-        d_hi = d, g_hi = trial->G;
+        d_hi = d, g_hi = trial->G, mg_hi = mgd;
       }
       // Defect correction (twice at most) while the corrected model brackets a root in [d_lo, d_hi].
-      modelled = modelled && k < 2 && corrected_G(c, miss, d_lo) > 0.0 && corrected_G(c, miss, d_hi) <= 0.0;
+      const double f_lo = modelled ? corrected(mg_lo, miss, d_lo) : 0.0;
+      const double f_hi = modelled ? corrected(mg_hi, miss, d_hi) : 0.0;
+      modelled = modelled && k < 2 && f_lo > 0.0 && f_hi <= 0.0;
       if (modelled) {
-        const double next = model_root(c, miss, d_lo, d_hi);
+        double mg_next = mg_hi;
+        const double next = model_root(c, miss, d_lo, d_hi, f_lo, f_hi, mg_next);
         if (next > d_lo && next < d_hi) {
           d = next;
+          mg_d = mg_next;
+          have_mg_d = true;
           continue;
         }
         modelled = false;
