@@ -23,6 +23,15 @@ FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshol
     v_impact_ += h * m.gravity * (1.0 + m.max_friction) * lever;
     v_spin_ = 4.0 * h * r;
   }
+  const int nv = m.vertex_count();
+  if (!m.curved() && nv <= kSoaVertices) {
+    soa_vertices_ = nv;
+    for (int i = 0; i < nv; ++i) {
+      vx_[i] = m.vertices[static_cast<std::size_t>(i)].x();
+      vy_[i] = m.vertices[static_cast<std::size_t>(i)].y();
+      vz_[i] = m.vertices[static_cast<std::size_t>(i)].z();
+    }
+  }
 }
 
 namespace {
@@ -49,6 +58,19 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
 }
 
 double FixedStepper::lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row, double t) const {
+  if (soa_vertices_ > 0) {
+    // Every corner's height in one vectorisable pass (the same products and sums, in the same
+    // order, as z_row.dot(vertex)), the contact set's corners masked out, then the minimum in
+    // vertex order: the same number as the loop below.
+    const int nv = soa_vertices_;
+    const double zx = z_row.x(), zy = z_row.y(), zz = z_row.z();
+    double z[kSoaVertices];
+    for (int i = 0; i < nv; ++i) z[i] = (zx * vx_[i] + zy * vy_[i]) + zz * vz_[i];
+    for (int k = 0; k < c.n; ++k) z[c.vertex[k]] = std::numeric_limits<double>::infinity();
+    double low = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < nv; ++i) low = std::min(low, z[i]);
+    return p.z() + v.z() * t + low - m_->rounding;
+  }
   const auto& verts = m_->vertices;
   const int nv = static_cast<int>(verts.size());
   double low = std::numeric_limits<double>::infinity();

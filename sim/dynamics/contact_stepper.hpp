@@ -99,6 +99,11 @@ class FixedStepper {
   // The same for a flat-faced die, given the orientation's bottom row at t.
   double lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row, double t) const;
   const DieModel* m_;
+  // The vertices by coordinate, for lowest_flat's vectorised pass (flat dice of up to
+  // kSoaVertices corners; soa_vertices_ = 0: the plain loop).
+  static constexpr int kSoaVertices = 64;
+  int soa_vertices_ = 0;
+  double vx_[kSoaVertices], vy_[kSoaVertices], vz_[kSoaVertices];
   double h_, v_impact_, touch_tol_;
   double v_spin_ = 0.0;  // Contact: 4 h r, the factor of |w|^2 in the threshold
   double dt_ = 0.0;
