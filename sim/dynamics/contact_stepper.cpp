@@ -99,8 +99,12 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
 
   // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact).
   const Vec3 L = Iw_start_ * s.omega;  // s.R is s0.R in every trial
-  // Built in place (the full step's is kept for model_G; the object is large, so no copies).
-  const TorqueFreeRotation& rot = (full ? full_rot_ : trial_rot_).emplace(m.principal_moments, s.R, L);
+  // Built in place (the full step's is kept for model_G; the object is large, so no copies). A
+  // trial of a step without contact has the full step's rotation exactly (the same s0.R and, with
+  // no impulse, the same angular momentum): it is reused.
+  const TorqueFreeRotation& rot = !full && c.n == 0 && full_rot_
+                                      ? *full_rot_
+                                      : (full ? full_rot_ : trial_rot_).emplace(m.principal_moments, s.R, L);
   rot_start_ = s.R;
   const Vec3 p = s.position, v = s.velocity;
   // Every body point lies within the bounding radius of the COM (|bottom row| = 1 to rounding, far
