@@ -23,6 +23,15 @@ FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshol
     v_impact_ += h * m.gravity * (1.0 + m.max_friction) * lever;
     v_spin_ = 4.0 * h * r;
   }
+  const int nv = m.vertex_count();
+  if (!m.curved() && nv <= kSoaVertices) {
+    soa_vertices_ = nv;
+    for (int i = 0; i < nv; ++i) {
+      vx_[i] = m.vertices[static_cast<std::size_t>(i)].x();
+      vy_[i] = m.vertices[static_cast<std::size_t>(i)].y();
+      vz_[i] = m.vertices[static_cast<std::size_t>(i)].z();
+    }
+  }
 }
 
 namespace {
@@ -45,7 +54,23 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
     const Mat3 R = t == 0.0 ? rot_start_ : rot.orientation(t);
     return p.z() + v.z() * t + rim_lowest_excluding(*m_, R, c);
   }
-  const Vec3 z_row = t == 0.0 ? Vec3(rot_start_.row(2).transpose()) : rot.bottom_row(t);
+  return lowest_flat(c, p, v, t == 0.0 ? Vec3(rot_start_.row(2).transpose()) : rot.bottom_row(t), t);
+}
+
+double FixedStepper::lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row, double t) const {
+  if (soa_vertices_ > 0) {
+    // Every corner's height in one vectorisable pass (the same products and sums, in the same
+    // order, as z_row.dot(vertex)), the contact set's corners masked out, then the minimum in
+    // vertex order: the same number as the loop below.
+    const int nv = soa_vertices_;
+    const double zx = z_row.x(), zy = z_row.y(), zz = z_row.z();
+    double z[kSoaVertices];
+    for (int i = 0; i < nv; ++i) z[i] = (zx * vx_[i] + zy * vy_[i]) + zz * vz_[i];
+    for (int k = 0; k < c.n; ++k) z[c.vertex[k]] = std::numeric_limits<double>::infinity();
+    double low = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < nv; ++i) low = std::min(low, z[i]);
+    return p.z() + v.z() * t + low - m_->rounding;
+  }
   const auto& verts = m_->vertices;
   const int nv = static_cast<int>(verts.size());
   double low = std::numeric_limits<double>::infinity();
@@ -69,13 +94,17 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   if (impact_) a.imp = imp_;
   a.next.n = 0;
   s.velocity.z() -= m.gravity * d;
-  if (c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next);
+  if (c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
   if (m.curved() && c.n > 0) apply_rolling_resistance(m, s, c, a.sup.normal_impulse);
 
   // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact).
-  const Vec3 L = world_inertia(m, s.R) * s.omega;
-  // Built in place (the full step's is kept for model_G; the object is large, so no copies).
-  const TorqueFreeRotation& rot = (full ? full_rot_ : trial_rot_).emplace(m.principal_moments, s.R, L);
+  const Vec3 L = Iw_start_ * s.omega;  // s.R is s0.R in every trial
+  // Built in place (the full step's is kept for model_G; the object is large, so no copies). A
+  // trial of a step without contact has the full step's rotation exactly (the same s0.R and, with
+  // no impulse, the same angular momentum): it is reused.
+  const TorqueFreeRotation& rot = !full && c.n == 0 && full_rot_
+                                      ? *full_rot_
+                                      : (full ? full_rot_ : trial_rot_).emplace(m.principal_moments, s.R, L);
   rot_start_ = s.R;
   const Vec3 p = s.position, v = s.velocity;
   // Every body point lies within the bounding radius of the COM (|bottom row| = 1 to rounding, far
@@ -84,25 +113,36 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   // search, which needs G's value, never starts from such a step). Most of `stepped`'s steps are
   // in the air: this skips their corner heights (and the rotation's evaluation for them).
   const double clear = p.z() + v.z() * d - (1.0 + 1e-9) * m.bounding_radius;
-  a.G = full && clear > 0.0 ? clear : lowest_new(c, p, v, rot, d);
+  // The step's end orientation is evaluated once: its bottom row is bit for bit the one
+  // bottom_row(d) returns (the same operations on the same row), so a flat die's corner heights
+  // come from it (a curved die's rim, and d = 0, keep lowest_new's own evaluation).
+  Mat3 R_end;
+  Vec3 w;
+  rot.state(d, R_end, w);
+  if (full && clear > 0.0)
+    a.G = clear;
+  else if (m.curved() || d == 0.0)
+    a.G = lowest_new(c, p, v, rot, d);
+  else
+    a.G = lowest_flat(c, p, v, R_end.row(2).transpose(), d);
   if (full) {
     full_p_ = p;
     full_v_ = v;
   }
   s.position = p + d * v;
-  Vec3 w;
-  rot.state(d, s.R, w);
+  s.R = R_end;
   s.omega = w;
 }
 
-double FixedStepper::model_root(const ContactSet& c, double miss, double lo, double hi) const {
-  double f_lo = corrected_G(c, miss, lo), f_hi = corrected_G(c, miss, hi);
+double FixedStepper::model_root(const ContactSet& c, double miss, double lo, double hi, double f_lo, double f_hi,
+                                double& g_model) const {
   int side = 0;
   double mid = hi;
   for (int it = 0; it < 100 && hi - lo > 1e-15 * h_; ++it) {
     mid = hi - f_hi * (hi - lo) / (f_hi - f_lo);
     if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
-    const double f = corrected_G(c, miss, mid);
+    g_model = model_G(c, mid);
+    const double f = corrected(g_model, miss, mid);
     if (std::abs(f) <= 1e-3 * touch_tol_) break;
     if (f > 0.0) {
       lo = mid, f_lo = f;
@@ -174,11 +214,13 @@ int FixedStepper::step(RigidState& s) {
   // trial step.
   RigidState s0 = s;
   impact_ = false;
+  geo_.valid = false;  // every solve of this step (its impact, each trial) shares s0.R and c
+  Iw_start_ = world_inertia(m, s0.R);
   if (c.n > 0) {
     double un = 0.0;
     for (int i = 0; i < c.n; ++i) un = std::min(un, corner_velocity(m, s0, c.vertex[i]).z());
     impact_ = un < -(v_impact_ + v_spin_ * s0.omega.squaredNorm());
-    if (impact_) imp_ = apply_friction_impact(m, s0, c, /*restitution=*/true);
+    if (impact_) imp_ = apply_friction_impact(m, s0, c, /*restitution=*/true, nullptr, nullptr, &geo_);
   }
   try_step(s0, c, h_, a_, /*full=*/true);
   const Attempt* done = &a_;
@@ -207,8 +249,17 @@ int FixedStepper::step(RigidState& s) {
       }
     }
     double d_lo = 0.0, d_hi = h_, g_hi = a_.G;
-    bool modelled = model_G(c, 0.0) > 0.0;
-    double d = modelled ? model_root(c, 0.0, 0.0, h_) : 0.5 * h_;
+    // The model's values at d_lo, d_hi and the next trial's d, each evaluated once (the model is a
+    // fixed function during the search: the full step's motion).
+    double mg_lo = model_G(c, 0.0), mg_hi = 0.0, mg_d = 0.0;
+    bool modelled = mg_lo > 0.0, have_mg_d = false;
+    double d = 0.5 * h_;
+    if (modelled) {
+      mg_hi = model_G(c, h_);
+      mg_d = mg_hi;
+      d = model_root(c, 0.0, 0.0, h_, corrected(mg_lo, 0.0, 0.0), corrected(mg_hi, 0.0, h_), mg_d);
+      have_mg_d = true;
+    }
     bool have_lo = false;
     int side = 0;
     done = nullptr;
@@ -222,21 +273,28 @@ int FixedStepper::step(RigidState& s) {
         break;
       }
       const double span = d * (h_ - d);
-      const double miss = span > 0.0 ? (trial->G - model_G(c, d)) / span : 0.0;
+      const double mgd = have_mg_d ? mg_d : model_G(c, d);
+      have_mg_d = false;
+      const double miss = span > 0.0 ? (trial->G - mgd) / span : 0.0;
       const bool above = trial->G > 0.0;
       if (above) {
-        d_lo = d, g_lo = trial->G;
+        d_lo = d, g_lo = trial->G, mg_lo = mgd;
         std::swap(trial, lo);  // the attempts are large: swap who is which, not their contents
         have_lo = true;
       } else {
-        d_hi = d, g_hi = trial->G;
+        d_hi = d, g_hi = trial->G, mg_hi = mgd;
       }
       // Defect correction (twice at most) while the corrected model brackets a root in [d_lo, d_hi].
-      modelled = modelled && k < 2 && corrected_G(c, miss, d_lo) > 0.0 && corrected_G(c, miss, d_hi) <= 0.0;
+      const double f_lo = modelled ? corrected(mg_lo, miss, d_lo) : 0.0;
+      const double f_hi = modelled ? corrected(mg_hi, miss, d_hi) : 0.0;
+      modelled = modelled && k < 2 && f_lo > 0.0 && f_hi <= 0.0;
       if (modelled) {
-        const double next = model_root(c, miss, d_lo, d_hi);
+        double mg_next = mg_hi;
+        const double next = model_root(c, miss, d_lo, d_hi, f_lo, f_hi, mg_next);
         if (next > d_lo && next < d_hi) {
           d = next;
+          mg_d = mg_next;
+          have_mg_d = true;
           continue;
         }
         modelled = false;

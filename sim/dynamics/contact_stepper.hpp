@@ -89,18 +89,29 @@ class FixedStepper {
   }
   // The model corrected by a trial's miss: model_G(t) + miss t (h - t) (the model is exact at
   // t = 0, the step's start, and at t = h, the full step itself).
-  double corrected_G(const ContactSet& c, double miss, double t) const { return model_G(c, t) + miss * t * (h_ - t); }
-  // The root of corrected_G in [lo, hi] (> 0 at lo, <= 0 at hi), Illinois.
-  double model_root(const ContactSet& c, double miss, double lo, double hi) const;
+  double corrected(double model_g, double miss, double t) const { return model_g + miss * t * (h_ - t); }
+  // The root of the corrected model in [lo, hi], given its values f_lo > 0 at lo and f_hi <= 0 at
+  // hi, Illinois. g_model: in, model_G(hi); out, model_G at the returned point.
+  double model_root(const ContactSet& c, double miss, double lo, double hi, double f_lo, double f_hi,
+                    double& g_model) const;
   // The lowest height over corners not in c, at time t of the free motion after the step's solve.
   double lowest_new(const ContactSet& c, const Vec3& p, const Vec3& v, const TorqueFreeRotation& rot, double t) const;
+  // The same for a flat-faced die, given the orientation's bottom row at t.
+  double lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row, double t) const;
   const DieModel* m_;
+  // The vertices by coordinate, for lowest_flat's vectorised pass (flat dice of up to
+  // kSoaVertices corners; soa_vertices_ = 0: the plain loop).
+  static constexpr int kSoaVertices = 64;
+  int soa_vertices_ = 0;
+  double vx_[kSoaVertices], vy_[kSoaVertices], vz_[kSoaVertices];
   double h_, v_impact_, touch_tol_;
   double v_spin_ = 0.0;  // Contact: 4 h r, the factor of |w|^2 in the threshold
   double dt_ = 0.0;
   Mat3 rot_start_ = Mat3::Identity();  // orientation at the start of the step being tried
+  Mat3 Iw_start_ = Mat3::Identity();   // its world inertia (every trial's angular momentum)
   Attempt a_, b_, lo_;                  // trial steps (members: ContactImpulses is large)
   ContactImpulses warm_;  // the last plastic solve's impulses (warm start of the next)
+  ContactGeometry geo_;   // the contact set-up of the current step (shared by its solves)
   std::optional<TorqueFreeRotation> full_rot_;   // the full step's free motion (model_G)
   std::optional<TorqueFreeRotation> trial_rot_;  // a shortened trial's
   Vec3 full_p_ = Vec3::Zero(), full_v_ = Vec3::Zero();

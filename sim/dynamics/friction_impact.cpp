@@ -26,20 +26,7 @@ constexpr int kCheapSweeps = 30;
 // face, whose split of the load over its corners is not unique; the velocities are.)
 constexpr double kSweepTolerance = 1e-11;
 
-// The contact points of one solve: lever arms, materials and the compliance blocks.
-struct Points {
-  int n = 0;
-  Vec3 r[kMaxContacts];
-  double e[kMaxContacts], mu[kMaxContacts];
-  double inv_wnn[kMaxContacts];              // 1 / W_nn
-  Eigen::Matrix2d wtt[kMaxContacts];         // tangential 2x2 block of W
-  Eigen::Matrix2d inv_wtt[kMaxContacts];     // its inverse
-  Mat3 W0;                                   // full compliance of point 0 (single-contact law)
-  // The body's response to a unit impulse at point i along x, y, z: angular velocity
-  // I_w^-1 (r x e_k), and the point's own velocity change along z (W's third column). The
-  // sweeps apply their impulses through these (no cross products or 3x3 products per update).
-  Vec3 ax[kMaxContacts], ay[kMaxContacts], az[kMaxContacts], wz[kMaxContacts];
-};
+using Points = ContactPoints;
 
 struct Body {
   double mass, inv_mass;
@@ -208,8 +195,7 @@ bool solve_plastic_single(const Body& b, const Points& pts, double pn[], Eigen::
   pn[0] = 0.0;
   pt[0].setZero();
   if (u.z() >= 0.0) return true;  // separating: no impulse
-  const Mat3 Winv = pts.W0.inverse();
-  const Vec3 stick = -(Winv * u);
+  const Vec3 stick = -(pts.W0_inverse * u);
   const double mu = pts.mu[0];
   if (stick.z() >= 0.0 && std::hypot(stick.x(), stick.y()) <= mu * stick.z()) {
     b.apply(r, stick);
@@ -745,6 +731,48 @@ SweepResult solve_friction(const Body& b, const Points& pts, const double radius
   return {kMaxSweeps + nr.iterations, nr.converged};
 }
 
+// The part of a solve's set-up that depends only on the orientation R and the contact set.
+void set_up_geometry(const DieModel& m, const Body& b, const Mat3& R, const ContactSet& c, ContactGeometry& geo) {
+  geo.Iw = world_inertia(m, R);
+  geo.inv_inertia = b.inv_inertia;
+  Points& pts = geo.pts;
+  pts.n = c.n;
+  // The lever arms in one contact plane: every point at the lowest one's height. Touching corners
+  // differ in height by up to the touch tolerance (a face landing a few 1e-9 m out of level); with
+  // each corner's own height, the tangential velocities of a face's corners depend on the plane's
+  // tilt, no motion makes all of them stick, the true solution slips at ~1e-9 of the speeds, and
+  // the solves stall there (pgs_unconverged on faces of Die 3 and the prisms). In one plane the
+  // face's problem is exactly consistent. (The lowest, not the mean: independent of the order.)
+  // Only points within the largest touch tolerance of the callers (1e-6 r) of the lowest: a set
+  // spread wider (a cylinder sunk into the floor by the stepper's drift, both rims' lowest points
+  // "touching") keeps its own geometry rather than a lever arm moved by a visible amount.
+  double plane_z = 0.0, top_z = 0.0;
+  for (int i = 0; i < c.n; ++i) {
+    pts.r[i] = contact_point(m, R, c.vertex[i]);
+    plane_z = i == 0 ? pts.r[i].z() : std::min(plane_z, pts.r[i].z());
+    top_z = i == 0 ? pts.r[i].z() : std::max(top_z, pts.r[i].z());
+  }
+  const bool one_plane = top_z - plane_z <= 1e-6 * m.bounding_radius;
+  for (int i = 0; i < c.n; ++i) {
+    const int v = c.vertex[i];
+    if (one_plane) pts.r[i].z() = plane_z;
+    pts.e[i] = m.vertex_restitution[v];
+    pts.mu[i] = m.vertex_friction[v];
+    const Mat3 W = compliance(b, pts.r[i]);
+    if (i == 0) pts.W0 = W;
+    pts.inv_wnn[i] = 1.0 / W(2, 2);
+    pts.wtt[i] = W.topLeftCorner<2, 2>();
+    pts.inv_wtt[i] = pts.wtt[i].inverse();
+    const Vec3& r = pts.r[i];
+    pts.ax[i] = b.inv_inertia * Vec3(0.0, r.z(), -r.y());
+    pts.ay[i] = b.inv_inertia * Vec3(-r.z(), 0.0, r.x());
+    pts.az[i] = b.inv_inertia * Vec3(r.y(), -r.x(), 0.0);
+    pts.wz[i] = W.col(2);
+  }
+  if (c.n == 1) pts.W0_inverse = pts.W0.inverse();
+  geo.valid = true;
+}
+
 }  // namespace
 
 ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol) {
@@ -775,50 +803,27 @@ ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol) 
 }
 
 ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,
-                                   const ContactImpulses* warm, ContactImpulses* out) {
+                                   const ContactImpulses* warm, ContactImpulses* out, ContactGeometry* geometry) {
   ImpactResult res;
   if (out) out->n = 0;
   if (c.n == 0) return res;
   if (c.dropped > 0) ++res.corrections.fallbacks;  // never silent: corners beyond kMaxContacts got no impulse
   const RigidState s0 = s;
-  const Mat3 Iw = world_inertia(m, s.R);
-  Body b{m.mass, 1.0 / m.mass, s.R * m.principal_moments.cwiseInverse().asDiagonal() * s.R.transpose(), &s};
-  Points pts;
-  pts.n = c.n;
+  // The set-up below depends only on the orientation and the contact set: shared through
+  // `geometry` by the solves of one stepper step (its impact and every trial).
+  ContactGeometry local;
+  ContactGeometry& geo = geometry ? *geometry : local;
+  if (!geo.valid) {
+    // (Body's own initialisation from the product, as the solve always had it: assigning the
+    // product to a matrix instead rounds differently.)
+    const Body b0{m.mass, 1.0 / m.mass, s.R * m.principal_moments.cwiseInverse().asDiagonal() * s.R.transpose(), &s};
+    set_up_geometry(m, b0, s.R, c, geo);
+  }
+  const Mat3& Iw = geo.Iw;
+  Body b{m.mass, 1.0 / m.mass, geo.inv_inertia, &s};
+  const Points& pts = geo.pts;
   double u0n[kMaxContacts];
-  // The lever arms in one contact plane: every point at the lowest one's height. Touching corners
-  // differ in height by up to the touch tolerance (a face landing a few 1e-9 m out of level); with
-  // each corner's own height, the tangential velocities of a face's corners depend on the plane's
-  // tilt, no motion makes all of them stick, the true solution slips at ~1e-9 of the speeds, and
-  // the solves stall there (pgs_unconverged on faces of Die 3 and the prisms). In one plane the
-  // face's problem is exactly consistent. (The lowest, not the mean: independent of the order.)
-  // Only points within the largest touch tolerance of the callers (1e-6 r) of the lowest: a set
-  // spread wider (a cylinder sunk into the floor by the stepper's drift, both rims' lowest points
-  // "touching") keeps its own geometry rather than a lever arm moved by a visible amount.
-  double plane_z = 0.0, top_z = 0.0;
-  for (int i = 0; i < c.n; ++i) {
-    pts.r[i] = contact_point(m, s.R, c.vertex[i]);
-    plane_z = i == 0 ? pts.r[i].z() : std::min(plane_z, pts.r[i].z());
-    top_z = i == 0 ? pts.r[i].z() : std::max(top_z, pts.r[i].z());
-  }
-  const bool one_plane = top_z - plane_z <= 1e-6 * m.bounding_radius;
-  for (int i = 0; i < c.n; ++i) {
-    const int v = c.vertex[i];
-    if (one_plane) pts.r[i].z() = plane_z;
-    pts.e[i] = m.vertex_restitution[v];
-    pts.mu[i] = m.vertex_friction[v];
-    const Mat3 W = compliance(b, pts.r[i]);
-    if (i == 0) pts.W0 = W;
-    pts.inv_wnn[i] = 1.0 / W(2, 2);
-    pts.wtt[i] = W.topLeftCorner<2, 2>();
-    pts.inv_wtt[i] = pts.wtt[i].inverse();
-    const Vec3& r = pts.r[i];
-    pts.ax[i] = b.inv_inertia * Vec3(0.0, r.z(), -r.y());
-    pts.ay[i] = b.inv_inertia * Vec3(-r.z(), 0.0, r.x());
-    pts.az[i] = b.inv_inertia * Vec3(r.y(), -r.x(), 0.0);
-    pts.wz[i] = W.col(2);
-    u0n[i] = b.point_velocity(pts.r[i]).z();
-  }
+  for (int i = 0; i < c.n; ++i) u0n[i] = b.point_velocity(pts.r[i]).z();
   const auto energy = [&](const RigidState& x) {
     return 0.5 * m.mass * x.velocity.squaredNorm() + 0.5 * x.omega.dot(Iw * x.omega);
   };

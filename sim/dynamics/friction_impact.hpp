@@ -60,6 +60,33 @@ struct ContactImpulses {
   Vec3 P[kMaxContacts];
 };
 
+// The contact points of one solve: lever arms, materials and the compliance blocks W (the
+// velocity change of the points per unit impulse), all functions of the orientation alone.
+struct ContactPoints {
+  int n = 0;
+  Vec3 r[kMaxContacts];
+  double e[kMaxContacts], mu[kMaxContacts];
+  double inv_wnn[kMaxContacts];              // 1 / W_nn
+  Eigen::Matrix2d wtt[kMaxContacts];         // tangential 2x2 block of W
+  Eigen::Matrix2d inv_wtt[kMaxContacts];     // its inverse
+  Mat3 W0;                                   // full compliance of point 0 (single-contact law)
+  Mat3 W0_inverse;                           // its inverse (set for one point only)
+  // The body's response to a unit impulse at point i along x, y, z: angular velocity
+  // I_w^-1 (r x e_k), and the point's own velocity change along z (W's third column). The
+  // sweeps apply their impulses through these (no cross products or 3x3 products per update).
+  Vec3 ax[kMaxContacts], ay[kMaxContacts], az[kMaxContacts], wz[kMaxContacts];
+};
+
+// A solve's set-up for one orientation and contact set: the world inertia, its inverse and the
+// points. Filled by the first apply_friction_impact given it (valid); solves of the same set at
+// the same orientation, at other velocities, reuse it (the stepper's trial steps). The caller
+// clears `valid` whenever the orientation or the set changes.
+struct ContactGeometry {
+  bool valid = false;
+  Mat3 Iw = Mat3::Identity(), inv_inertia = Mat3::Identity();
+  ContactPoints pts;
+};
+
 struct ImpactResult {
   double normal_impulse = 0.0;  // sum over the points (N s)
   double energy_before = 0.0;   // kinetic energy (J)
@@ -75,9 +102,11 @@ ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol);
 // Impact with restitution (true) or perfectly plastic (false, used for sustained contact), with
 // Coulomb friction. Updates s.velocity and s.omega; positions are untouched. `warm`: impulses of
 // a previous solve (matched by vertex) to start the compression from; `out`: the impulse at every
-// point (compression plus restitution). Both optional.
+// point (compression plus restitution); `geometry`: the set-up shared with other solves of c at
+// s.R (see ContactGeometry). All optional.
 ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,
-                                   const ContactImpulses* warm = nullptr, ContactImpulses* out = nullptr);
+                                   const ContactImpulses* warm = nullptr, ContactImpulses* out = nullptr,
+                                   ContactGeometry* geometry = nullptr);
 
 // Velocity of corner `vertex`'s contact point (world).
 inline Vec3 corner_velocity(const DieModel& m, const RigidState& s, int vertex) {
