@@ -169,7 +169,9 @@ TossResult toss(const DieModel& m, std::uint64_t seed, std::uint64_t index, Toss
     // `static` reads only the orientation (and the height, for the start's validity).
     init = draw_initial_state(m.throw_, seed, index, /*motion=*/m.fidelity != Fidelity::Static);
   }
-  return run(m, init, tiebreak_of(seed, index), probe);
+  // `paper` breaks no exact balances (its stop rule reads the face directly): no Philox block for it.
+  const double tiebreak = m.fidelity == Fidelity::Paper ? 0.0 : tiebreak_of(seed, index);
+  return run(m, init, tiebreak, probe);
 }
 
 }  // namespace dicesim
