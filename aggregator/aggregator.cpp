@@ -343,6 +343,7 @@ void Aggregator::grant(std::int64_t worker, double now) {
       a = frontier_, b = frontier_ + size;
       frontier_ = b;
     }
+    if (b == 0 && held == 0 && !steal(worker, now, a, b)) return;
     if (b == 0) return;
     Lease l;
     l.id = next_lease_++;
@@ -366,6 +367,41 @@ void Aggregator::grant(std::int64_t worker, double now) {
     m.deadline_utime = m.utime + static_cast<std::int64_t>((l.deadline - now) * 1e6);
     publish(wire::kWorkLease, m);
   }
+}
+
+bool Aggregator::steal(std::int64_t worker, double now, std::uint64_t& a, std::uint64_t& b) {
+  // Without this the run ends when its slowest worker has finished both leases it holds (up to
+  // 2 x max_lease tosses, tens of ms of `paper` on a quiet machine and far more when another
+  // process takes that worker's core) while the others idle.
+  Lease* victim = nullptr;
+  std::uint64_t lo = 0, hi = 0;
+  for (auto& [id, l] : leases_) {
+    if (l.worker == worker || l.done_at >= 0) continue;
+    const std::uint64_t end = std::min(limit_, l.first + l.count);
+    const auto g = received_.gaps(l.first, end);
+    // A worker tosses a lease in index order: it is at about the first missing index.
+    if (!g.empty() && end - g.front().first > hi - lo) victim = &l, lo = g.front().first, hi = end;
+  }
+  // Halves of at least min_lease, so that a split is worth its two messages.
+  if (!victim || hi - lo < 2 * cfg_.min_lease) return false;
+  const std::uint64_t cut = lo + (hi - lo) / 2;
+  victim->count = cut - victim->first;
+  ++health_.splits;
+  health_.split_tosses += hi - cut;
+  // The holder hears its lease again with the same id and a smaller count, and stops at `cut`.
+  // Should it not hear it (a lost message, a worker of an older build), it tosses the moved half
+  // too: duplicates, which are ignored, never a gap.
+  dicesim_lcm::work_lease m;
+  m.utime = wire::now_utime();
+  m.run_id = cfg_.spec.run_id;
+  m.worker_id = victim->worker;
+  m.lease_id = victim->id;
+  m.first_index = static_cast<std::int64_t>(victim->first);
+  m.count = static_cast<std::int64_t>(victim->count);
+  m.deadline_utime = m.utime + static_cast<std::int64_t>((victim->deadline - now) * 1e6);
+  publish(wire::kWorkLease, m);
+  a = cut, b = hi;
+  return true;
 }
 
 int Aggregator::live_workers() const {

@@ -29,7 +29,8 @@ std::string health_line(const Health& h) {
          ", rejected: foreign " + std::to_string(h.foreign) + ", malformed " + std::to_string(h.malformed) +
          ", out of range " + std::to_string(h.range) + "; re-leased " + std::to_string(h.released) +
          " tosses; messages in " + std::to_string(h.messages_in) + ", out " + std::to_string(h.messages_out) +
-         ", unauthenticated " + std::to_string(h.unauthenticated);
+         ", unauthenticated " + std::to_string(h.unauthenticated) + "; tail splits " + std::to_string(h.splits) + " (" +
+         std::to_string(h.split_tosses) + " tosses)";
 }
 
 SessionResult run_session(const SessionOptions& opt, const AggregatorConfig& cfg) {

@@ -32,6 +32,8 @@ struct Net {
   std::unique_ptr<agg::Aggregator> agg;
   std::vector<std::unique_ptr<worker::WorkerCore>> workers;
   std::vector<bool> alive;
+  std::vector<int> period;  // worker w computes a batch every period[w] steps (a slower core)
+  int steps = 0;
   double now = 0.0;
   std::vector<Message> all_batches;  // for replays
 
@@ -49,13 +51,18 @@ struct Net {
     c.batch = 100;
     workers.push_back(std::make_unique<worker::WorkerCore>(c, sender()));
     alive.push_back(true);
+    period.push_back(1);
   }
   // Advances 10 ms of simulated time: every live worker may compute one batch.
   void step() {
     now += 0.01;
+    ++steps;
     agg->tick(now);
     for (std::size_t w = 0; w < workers.size(); ++w)
-      if (alive[w]) workers[w]->tick(now), workers[w]->step(now);
+      if (alive[w]) {
+        workers[w]->tick(now);
+        if (steps % period[w] == 0) workers[w]->step(now);
+      }
     while (!queue.empty()) {
       Message m = std::move(queue.front());
       queue.pop_front();
@@ -148,6 +155,24 @@ TEST(AggregatorRun, DeadWorkersLeasesGoToTheOthers) {
   ASSERT_TRUE(net.run());
   EXPECT_EQ(net.agg->result(), f.reference(12000));
   EXPECT_GT(net.agg->health().released, 0u);
+}
+
+// One worker ten times slower than the other (another process on its core): at the end the fast
+// one takes the back half of the slow one's unfinished leases, which the slow one then skips,
+// instead of idling until the slow one has tossed both leases it holds.
+TEST(AggregatorRun, AnIdleWorkerTakesHalfOfASlowWorkersLeaseAtTheEnd) {
+  Fixture f(20000);
+  Net net = make_net(f, 2);
+  net.period[1] = 10;
+  ASSERT_TRUE(net.run());
+  EXPECT_EQ(net.agg->result(), f.reference(20000));
+  EXPECT_GT(net.agg->health().splits, 0u);
+  // 100 tosses per 10 ms plus 100 per 100 ms: 20000 take 1.82 s. Without splitting, the slow
+  // worker still holds up to 2 x 700 tosses when the fast one runs out: about 1.4 s more.
+  EXPECT_LT(net.now, 2.1);
+  // The slow worker heard its leases shortened and skipped their moved halves: few duplicates.
+  EXPECT_LT(net.agg->health().duplicates, 2 * 100 * net.agg->health().splits);
+  EXPECT_EQ(net.workers[0]->tosses_done() + net.workers[1]->tosses_done(), 20000u + net.agg->health().duplicates);
 }
 
 TEST(AggregatorRun, LateWorkerTakesPart) {

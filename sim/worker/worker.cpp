@@ -65,7 +65,7 @@ void WorkerCore::on_message(std::string_view channel, const void* data, std::siz
   if (channel == wire::kRunStart) {
     if (auto m = wire::decode<dicesim_lcm::run_start>(data, len)) return on_run_start(*m, now);
   } else if (channel == wire::kWorkLease) {
-    if (auto m = wire::decode<dicesim_lcm::work_lease>(data, len)) return on_lease(*m);
+    if (auto m = wire::decode<dicesim_lcm::work_lease>(data, len)) return on_lease(*m, now);
   } else if (channel == wire::kProbabilities) {
     if (auto m = wire::decode<dicesim_lcm::probabilities>(data, len)) {
       if (run_ && m->run_id == run_->spec.run_id && m->finished == 1) end_run("finished");
@@ -130,18 +130,31 @@ void WorkerCore::start_run(wire::RunSpec spec, const DieModel* known, double now
   send_status(now);
 }
 
-void WorkerCore::on_lease(const dicesim_lcm::work_lease& m) {
+void WorkerCore::on_lease(const dicesim_lcm::work_lease& m, double now) {
   if (!run_ || !run_->model || m.run_id != run_->spec.run_id || m.worker_id != cfg_.worker_id) return;
   const std::uint64_t total = run_->spec.total;
   if (m.lease_id <= last_done_ || m.count <= 0 || m.first_index < 0 || static_cast<std::uint64_t>(m.first_index) >= total ||
-      static_cast<std::uint64_t>(m.count) > total - static_cast<std::uint64_t>(m.first_index) || leases_.size() >= 16) {
+      static_cast<std::uint64_t>(m.count) > total - static_cast<std::uint64_t>(m.first_index)) {
     ++ignored_;
     return;
   }
-  for (const Lease& l : leases_)
-    if (l.id == m.lease_id) return;
   const std::uint64_t first = static_cast<std::uint64_t>(m.first_index);
-  Lease l{m.lease_id, first, first + static_cast<std::uint64_t>(m.count)};
+  const std::uint64_t end = first + static_cast<std::uint64_t>(m.count);
+  for (auto it = leases_.begin(); it != leases_.end(); ++it) {
+    if (it->id != m.lease_id) continue;
+    // The same lease, shorter: the aggregator gave its back part to an idle worker (the run's
+    // tail). Anything else under a known id (a repeat, a longer count) changes nothing.
+    if (first == it->first && end < it->end) {
+      it->end = std::max(end, it->next);
+      if (it->next == it->end) finish_lease(it, now);  // it had already tossed up to the new end
+    }
+    return;
+  }
+  if (leases_.size() >= 16) {
+    ++ignored_;
+    return;
+  }
+  Lease l{m.lease_id, first, first, end};
   leases_.insert(std::upper_bound(leases_.begin(), leases_.end(), l, [](const Lease& a, const Lease& b) { return a.id < b.id; }),
                  l);
   last_lease_seen_ = std::max(last_lease_seen_, m.lease_id);
@@ -264,12 +277,14 @@ bool WorkerCore::step(double now) {
   send(wire::kTossBatch, wire::encode(b));
   l.next += n;
   tosses_done_ += n;
-  if (l.next == l.end) {
-    last_done_ = l.id;
-    leases_.pop_front();
-    send_status(now);  // "done with that one": the aggregator may re-lease what it did not get
-  }
+  if (l.next == l.end) finish_lease(leases_.begin(), now);
   return true;
+}
+
+void WorkerCore::finish_lease(std::deque<Lease>::iterator it, double now) {
+  last_done_ = it->id;
+  leases_.erase(it);
+  send_status(now);  // "done with that one": the aggregator may re-lease what it did not get
 }
 
 namespace {

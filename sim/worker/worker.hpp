@@ -68,13 +68,15 @@ class WorkerCore {
   };
   struct Lease {
     std::int64_t id;
-    std::uint64_t next, end;
+    std::uint64_t first, next, end;
   };
 
   void on_run_start(const dicesim_lcm::run_start& m, double now);
   // Takes up `spec` (run_start's, or adopt's); `known`: its model, already compiled (else compiled here).
   void start_run(wire::RunSpec spec, const DieModel* known, double now);
-  void on_lease(const dicesim_lcm::work_lease& m);
+  void on_lease(const dicesim_lcm::work_lease& m, double now);
+  // Every batch of the lease is out: drop it and tell the aggregator.
+  void finish_lease(std::deque<Lease>::iterator it, double now);
   // `final`: the run is over for good (finished, replaced); otherwise (its aggregator went
   // silent) the same run may be served again when its run_start comes back (a resumed aggregator).
   void end_run(const char* why, bool final = true);
