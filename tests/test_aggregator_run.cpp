@@ -2,6 +2,7 @@
 // hostile messages, dead workers — and always the counts of run_tosses on one thread.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <deque>
 #include <memory>
 #include <random>
@@ -358,3 +359,57 @@ TEST(AggregatorRun, AnAdoptedWorkerWhoseReadyWasLostRepeatsItOnRunStart) {
 
 }  // namespace
 
+
+namespace {
+
+// A worker's batches hold about WorkerConfig::batch_s of work: growing at most fourfold a batch up
+// to `batch` when tosses are cheap (fewer messages), down to 256 tosses when they are slow (a
+// heartbeat, a lease hand-over or the run's end is never a long batch away).
+TEST(AggregatorRun, BatchesHoldAboutBatchSOfWork) {
+  Fixture f(100000);
+  std::vector<int> counts;
+  worker::WorkerConfig c;
+  c.batch = 8192;
+  c.batch_s = 0.02;
+  worker::WorkerCore w(c, [&](const char* ch, const std::vector<std::uint8_t>& b) {
+    if (std::string(ch) == wire::kTossBatch) counts.push_back(wire::decode<dicesim_lcm::toss_batch>(b.data(), b.size())->count);
+  });
+  w.adopt(f.spec, f.model, 0.0);
+  dicesim_lcm::work_lease m{};
+  m.run_id = f.spec.run_id, m.worker_id = w.id(), m.lease_id = 1, m.first_index = 0, m.count = 100000;
+  const auto lease = wire::encode(m);
+  w.on_message(wire::kWorkLease, lease.data(), lease.size(), 0.0);
+  double now = 0.0;
+  for (int i = 0; i < 5; ++i, now += 0.001) ASSERT_TRUE(w.step(now));  // 1 ms a batch, whatever its size
+  EXPECT_EQ(counts, (std::vector<int>{512, 2048, 8192, 8192, 8192}));
+  counts.clear();
+  for (int i = 0; i < 2; ++i) {
+    now += 2.0;  // 2 s a batch
+    ASSERT_TRUE(w.step(now));
+  }
+  EXPECT_EQ(counts, (std::vector<int>{256, 256}));
+}
+
+// Stopping (SIGTERM from `dicesim run` once the run is over): a batch in progress ends within
+// 64 tosses and is not published.
+TEST(AggregatorRun, ACancelledWorkerStopsInsideABatch) {
+  Fixture f(10000);
+  std::atomic<bool> stop{true};
+  int batches = 0;
+  worker::WorkerConfig c;
+  c.cancel = &stop;
+  worker::WorkerCore w(c, [&](const char* ch, const std::vector<std::uint8_t>&) { batches += std::string(ch) == wire::kTossBatch; });
+  w.adopt(f.spec, f.model, 0.0);
+  dicesim_lcm::work_lease m{};
+  m.run_id = f.spec.run_id, m.worker_id = w.id(), m.lease_id = 1, m.first_index = 0, m.count = 10000;
+  const auto lease = wire::encode(m);
+  w.on_message(wire::kWorkLease, lease.data(), lease.size(), 0.0);
+  EXPECT_FALSE(w.step(0.0));
+  EXPECT_EQ(batches, 0);
+  EXPECT_EQ(w.tosses_done(), 0u);
+  stop = false;
+  EXPECT_TRUE(w.step(0.1));
+  EXPECT_EQ(batches, 1);
+}
+
+}  // namespace

@@ -105,6 +105,7 @@ void WorkerCore::start_run(wire::RunSpec spec, const DieModel* known, double now
   leases_.clear();
   last_lease_seen_ = last_done_ = 0;
   tosses_done_ = rate_n_ = 0;
+  batch_now_ = 0, last_n_ = 0;  // another run may be another fidelity
   rate_t_ = now;
   const wire::RunSpec& s = run_->spec;
   try {
@@ -202,11 +203,23 @@ void WorkerCore::tick(double now) {
 }
 
 bool WorkerCore::step(double now) {
-  if (!run_ || !run_->model || leases_.empty()) return false;
+  if (!run_ || !run_->model || leases_.empty()) {
+    last_n_ = 0;  // idle: the next step's wait is not a batch's cost
+    return false;
+  }
   const DieModel& model = *run_->model;
   const wire::RunSpec& spec = run_->spec;
   Lease& l = leases_.front();
-  const std::uint64_t n = std::min<std::uint64_t>(static_cast<std::uint64_t>(cfg_.batch), l.end - l.next);
+  // Steps follow each other while there is work: the time since the last one is its batch's
+  // cost. Sized to batch_s of work, growing at most fourfold a step; never below 256 tosses.
+  if (batch_now_ == 0) batch_now_ = std::min(cfg_.batch, 512);
+  if (last_n_ > 0 && now > last_step_) {
+    const double fit = cfg_.batch_s * static_cast<double>(last_n_) / (now - last_step_);
+    batch_now_ = std::min(cfg_.batch, static_cast<int>(std::max(256.0, std::min(fit, 4.0 * batch_now_))));
+  }
+  const std::uint64_t n = std::min<std::uint64_t>(static_cast<std::uint64_t>(batch_now_), l.end - l.next);
+  last_step_ = now;
+  last_n_ = n;
 
   // Bounce-state budget for this batch: a token bucket refilled at max_trace_per_s.
   trace_tokens_ = std::min(cfg_.max_trace_per_s, trace_tokens_ + (now - trace_t_) * cfg_.max_trace_per_s);
@@ -225,6 +238,7 @@ bool WorkerCore::step(double now) {
   b.n_corrected = 0;
   std::vector<BounceRecord> records;
   for (std::uint64_t k = 0; k < n; ++k) {
+    if (k % 64 == 63 && cfg_.cancel && cfg_.cancel->load(std::memory_order_relaxed)) return false;
     const std::uint64_t i = l.next + k;
     const bool traced = spec.trace_every > 0 && i % static_cast<std::uint64_t>(spec.trace_every) == 0;
     records.clear();
