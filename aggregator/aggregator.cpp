@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <stdexcept>
 #include <unordered_set>
 
@@ -183,7 +184,7 @@ void Aggregator::on_batch(const dicesim_lcm::toss_batch& b, double now) {
     return;
   }
   ++health_.batches;
-  if (auto w = workers_.find(b.worker_id); w != workers_.end()) w->second.last_seen = now;
+  if (auto w = workers_.find(b.worker_id); w != workers_.end()) w->second.last_seen = now, w->second.batch = static_cast<std::uint64_t>(b.count);
   const std::uint64_t first = static_cast<std::uint64_t>(b.first_index), n = static_cast<std::uint64_t>(b.count);
   const std::uint64_t fresh = received_.add(first, first + n, [&](std::uint64_t lo, std::uint64_t hi) {
     ingest(first, lo, hi, b);
@@ -375,12 +376,22 @@ bool Aggregator::steal(std::int64_t worker, double now, std::uint64_t& a, std::u
   // process takes that worker's core) while the others idle.
   Lease* victim = nullptr;
   std::uint64_t lo = 0, hi = 0;
-  for (auto& [id, l] : leases_) {
-    if (l.worker == worker || l.done_at >= 0) continue;
+  std::set<std::int64_t> started;  // workers whose lease in progress (their lowest id) was seen
+  for (auto& [id, l] : leases_) {  // in id order
+    if (l.done_at >= 0) continue;
+    const bool in_progress = started.insert(l.worker).second;
+    if (l.worker == worker) continue;
     const std::uint64_t end = std::min(limit_, l.first + l.count);
     const auto g = received_.gaps(l.first, end);
-    // A worker tosses a lease in index order: it is at about the first missing index.
-    if (!g.empty() && end - g.front().first > hi - lo) victim = &l, lo = g.front().first, hi = end;
+    if (g.empty()) continue;
+    // A worker tosses its leases in id order and each in index order: it is at about the first
+    // missing index of the lease in progress plus the batch it is tossing (as large as its last).
+    std::uint64_t at = g.front().first;
+    if (in_progress) {
+      const auto w = workers_.find(l.worker);
+      at += w != workers_.end() ? w->second.batch : 0;
+    }
+    if (at < end && end - at > hi - lo) victim = &l, lo = at, hi = end;
   }
   // Halves of at least min_lease, so that a split is worth its two messages.
   if (!victim || hi - lo < 2 * cfg_.min_lease) return false;

@@ -114,6 +114,7 @@ class Aggregator {
     double last_seen = 0.0;
     double rate = 0.0;
     bool ready = false;
+    std::uint64_t batch = 0;  // its last batch's size: about what it has tossed past what arrived
   };
 
   void on_batch(const dicesim_lcm::toss_batch& b, double now);
