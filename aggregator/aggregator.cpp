@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <stdexcept>
 #include <unordered_set>
 
@@ -183,7 +184,7 @@ void Aggregator::on_batch(const dicesim_lcm::toss_batch& b, double now) {
     return;
   }
   ++health_.batches;
-  if (auto w = workers_.find(b.worker_id); w != workers_.end()) w->second.last_seen = now;
+  if (auto w = workers_.find(b.worker_id); w != workers_.end()) w->second.last_seen = now, w->second.batch = static_cast<std::uint64_t>(b.count);
   const std::uint64_t first = static_cast<std::uint64_t>(b.first_index), n = static_cast<std::uint64_t>(b.count);
   const std::uint64_t fresh = received_.add(first, first + n, [&](std::uint64_t lo, std::uint64_t hi) {
     ingest(first, lo, hi, b);
@@ -343,6 +344,7 @@ void Aggregator::grant(std::int64_t worker, double now) {
       a = frontier_, b = frontier_ + size;
       frontier_ = b;
     }
+    if (b == 0 && held == 0 && !steal(worker, now, a, b)) return;
     if (b == 0) return;
     Lease l;
     l.id = next_lease_++;
@@ -366,6 +368,51 @@ void Aggregator::grant(std::int64_t worker, double now) {
     m.deadline_utime = m.utime + static_cast<std::int64_t>((l.deadline - now) * 1e6);
     publish(wire::kWorkLease, m);
   }
+}
+
+bool Aggregator::steal(std::int64_t worker, double now, std::uint64_t& a, std::uint64_t& b) {
+  // Without this the run ends when its slowest worker has finished both leases it holds (up to
+  // 2 x max_lease tosses, tens of ms of `paper` on a quiet machine and far more when another
+  // process takes that worker's core) while the others idle.
+  Lease* victim = nullptr;
+  std::uint64_t lo = 0, hi = 0;
+  std::set<std::int64_t> started;  // workers whose lease in progress (their lowest id) was seen
+  for (auto& [id, l] : leases_) {  // in id order
+    if (l.done_at >= 0) continue;
+    const bool in_progress = started.insert(l.worker).second;
+    if (l.worker == worker) continue;
+    const std::uint64_t end = std::min(limit_, l.first + l.count);
+    const auto g = received_.gaps(l.first, end);
+    if (g.empty()) continue;
+    // A worker tosses its leases in id order and each in index order: it is at about the first
+    // missing index of the lease in progress plus the batch it is tossing (as large as its last).
+    std::uint64_t at = g.front().first;
+    if (in_progress) {
+      const auto w = workers_.find(l.worker);
+      at += w != workers_.end() ? w->second.batch : 0;
+    }
+    if (at < end && end - at > hi - lo) victim = &l, lo = at, hi = end;
+  }
+  // Halves of at least min_lease, so that a split is worth its two messages.
+  if (!victim || hi - lo < 2 * cfg_.min_lease) return false;
+  const std::uint64_t cut = lo + (hi - lo) / 2;
+  victim->count = cut - victim->first;
+  ++health_.splits;
+  health_.split_tosses += hi - cut;
+  // The holder hears its lease again with the same id and a smaller count, and stops at `cut`.
+  // Should it not hear it (a lost message, a worker of an older build), it tosses the moved half
+  // too: duplicates, which are ignored, never a gap.
+  dicesim_lcm::work_lease m;
+  m.utime = wire::now_utime();
+  m.run_id = cfg_.spec.run_id;
+  m.worker_id = victim->worker;
+  m.lease_id = victim->id;
+  m.first_index = static_cast<std::int64_t>(victim->first);
+  m.count = static_cast<std::int64_t>(victim->count);
+  m.deadline_utime = m.utime + static_cast<std::int64_t>((victim->deadline - now) * 1e6);
+  publish(wire::kWorkLease, m);
+  a = cut, b = hi;
+  return true;
 }
 
 int Aggregator::live_workers() const {

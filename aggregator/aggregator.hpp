@@ -55,6 +55,9 @@ struct Health {
   std::uint64_t messages_out = 0;
   std::uint64_t messages_in = 0;
   std::uint64_t unauthenticated = 0;  // with a key: no seal, or a wrong one (forged, tampered, another key)
+  // The run's tail: leases split so that an idle worker takes the back half of another's
+  // unfinished one (steal), and the tosses so moved. Not in checkpoints (they do not change the answer).
+  std::uint64_t splits = 0, split_tosses = 0;
 };
 
 // What a resumed aggregator found in its checkpoint.
@@ -111,6 +114,7 @@ class Aggregator {
     double last_seen = 0.0;
     double rate = 0.0;
     bool ready = false;
+    std::uint64_t batch = 0;  // its last batch's size: about what it has tossed past what arrived
   };
 
   void on_batch(const dicesim_lcm::toss_batch& b, double now);
@@ -120,6 +124,9 @@ class Aggregator {
   void advance_prefix();
   void grant(std::int64_t worker, double now);
   void release(const Lease& l);  // hand the lease's missing indices out again
+  // Nothing left to lease and `worker` idle: moves the back half of the largest unfinished lease
+  // of another worker to [a, b) (false: none worth splitting).
+  bool steal(std::int64_t worker, double now, std::uint64_t& a, std::uint64_t& b);
   void finish(double now);
   void publish_run_start();
   void publish_probabilities(double now);

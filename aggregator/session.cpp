@@ -29,7 +29,8 @@ std::string health_line(const Health& h) {
          ", rejected: foreign " + std::to_string(h.foreign) + ", malformed " + std::to_string(h.malformed) +
          ", out of range " + std::to_string(h.range) + "; re-leased " + std::to_string(h.released) +
          " tosses; messages in " + std::to_string(h.messages_in) + ", out " + std::to_string(h.messages_out) +
-         ", unauthenticated " + std::to_string(h.unauthenticated);
+         ", unauthenticated " + std::to_string(h.unauthenticated) + "; tail splits " + std::to_string(h.splits) + " (" +
+         std::to_string(h.split_tosses) + " tosses)";
 }
 
 SessionResult run_session(const SessionOptions& opt, const AggregatorConfig& cfg) {
@@ -68,7 +69,10 @@ SessionResult run_session(const SessionOptions& opt, const AggregatorConfig& cfg
     sub->setQueueCapacity(ch == wire::kBounceState ? 64 : opt.queue_capacity);
   }
 
-  double last_tick = -1.0;
+  // The first tick at once: run_start goes out now, not after the first wait for a message (up to
+  // 10 ms), in case the workers spoke before this subscribed.
+  double last_tick = seconds_since(t0);
+  agg.tick(last_tick);
   for (;;) {
     if (opt.cancel && opt.cancel->load()) {
       res.end = SessionEnd::Cancelled;

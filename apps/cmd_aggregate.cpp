@@ -97,7 +97,7 @@ PreparedRun prepare_run(const AggregateArgs& a, std::int64_t run_id) {
 
 int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::int64_t run_id, int workers,
                          const std::function<std::string()>& on_tick, const std::atomic<bool>* cancel,
-                         const PreparedRun* prepared) {
+                         const PreparedRun* prepared, const std::function<void()>& on_session_end) {
   std::optional<agg::Checkpoint> resume;
   if (!a.resume.empty()) {
     if (!a.scene.path.empty() || !a.scene.overrides.empty() || !a.scene.fidelity.empty())
@@ -167,6 +167,7 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
     return on_tick ? on_tick() : std::string();
   };
   const agg::SessionResult res = agg::run_session(opt, cfg);
+  if (on_session_end) on_session_end();
   bar.finish();
   // The health line (tests/integration greps it) is a log line: info, with the run's context.
   spdlog::info("run {}: {}", spec.run_id, agg::health_line(res.health));

@@ -48,7 +48,9 @@ int run_run(const RunArgs& a) {
         // After Ctrl-C the workers (same process group) exit too: that is the interrupt, not a failure.
         return children.poll() == 0 && !g_stop ? "every worker process exited before the run finished" : "";
       },
-      &g_stop, &prepared);
+      &g_stop, &prepared,
+      // The run is over: the workers may stop (a batch in progress too) while the report prints.
+      [&children] { children.terminate_all(); });
   children.stop_all();
   return code;
 }

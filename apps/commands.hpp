@@ -76,9 +76,10 @@ PreparedRun prepare_run(const AggregateArgs& a, std::int64_t run_id);
 // Starts the run on `url`, aggregates it to the end and prints the report as `toss` does.
 // `workers` (> 0) is reported as the thread count; `on_tick` may return an error to abort.
 // `prepared`: the run, already compiled (prepare_run with this `a`); else it is compiled here.
+// `on_session_end`: called as soon as the run is over, before the report (run stops its workers).
 int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::int64_t run_id, int workers,
                          const std::function<std::string()>& on_tick, const std::atomic<bool>* cancel,
-                         const PreparedRun* prepared = nullptr);
+                         const PreparedRun* prepared = nullptr, const std::function<void()>& on_session_end = {});
 // The body of `dicesim worker --lcm URL --quiet --run ID --once [--key-file FILE]` in a child that
 // `run` forked without exec (worker_processes.cpp): it serves `run` from the start. Returns the
 // exit code.

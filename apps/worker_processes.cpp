@@ -67,8 +67,12 @@ int WorkerProcesses::poll() {
   return static_cast<int>(pids_.size());
 }
 
-void WorkerProcesses::stop_all() {
+void WorkerProcesses::terminate_all() {
   for (pid_t p : pids_) kill(p, SIGTERM);
+}
+
+void WorkerProcesses::stop_all() {
+  terminate_all();
   const auto t0 = std::chrono::steady_clock::now();
   while (!pids_.empty()) {
     for (auto it = pids_.begin(); it != pids_.end();) {
@@ -83,7 +87,7 @@ void WorkerProcesses::stop_all() {
     }
     // Workers that saw the run finish exit on their own within a few ms: poll finely, the run's
     // wall time includes this wait.
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
 }
 

@@ -31,6 +31,8 @@ class WorkerProcesses {
              const PreparedRun* run = nullptr);
   // Reaps exited workers (warning on stderr for abnormal exits); returns how many still run.
   int poll();
+  // Sends SIGTERM to every worker still running (stop_all then only waits).
+  void terminate_all();
   // SIGTERM, then SIGKILL for those still running after 2 s.
   void stop_all();
 

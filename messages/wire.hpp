@@ -30,8 +30,12 @@ inline constexpr const char* kDefaultUrl = "udpm://239.255.76.67:7667?ttl=0";
 // --lcm URL, else $LCM_DEFAULT_URL, else kDefaultUrl.
 std::string resolve_url(const std::string& flag);
 
-// A toss_batch carries at most this many tosses: 6 bytes each, ~12 KB, one datagram.
-inline constexpr int kMaxBatch = 2048;
+// A toss_batch carries at most kMaxBatch tosses: 6 bytes each, ~48 KB, one LCM datagram (under
+// 64 KB). A worker publishes kDefaultBatch (~12 KB) unless told otherwise: on a LAN a datagram is
+// cut into 1500-byte IP fragments and one lost fragment loses it; `dicesim run` on its
+// host-confined URL (nothing leaves the machine, loopback MTU 64 KB) uses kMaxBatch.
+inline constexpr int kMaxBatch = 8192;
+inline constexpr int kDefaultBatch = 2048;
 
 // A die's outcomes on the wire (run_start, probabilities): 1 to kMaxOutcomes labels, ascending,
 // each in [0, kMaxLabel]. A toss result is an index into them (int8: kMaxOutcomes must stay < 128).

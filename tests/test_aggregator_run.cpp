@@ -2,6 +2,7 @@
 // hostile messages, dead workers — and always the counts of run_tosses on one thread.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <deque>
 #include <memory>
 #include <random>
@@ -32,6 +33,8 @@ struct Net {
   std::unique_ptr<agg::Aggregator> agg;
   std::vector<std::unique_ptr<worker::WorkerCore>> workers;
   std::vector<bool> alive;
+  std::vector<int> period;  // worker w computes a batch every period[w] steps (a slower core)
+  int steps = 0;
   double now = 0.0;
   std::vector<Message> all_batches;  // for replays
 
@@ -49,13 +52,18 @@ struct Net {
     c.batch = 100;
     workers.push_back(std::make_unique<worker::WorkerCore>(c, sender()));
     alive.push_back(true);
+    period.push_back(1);
   }
   // Advances 10 ms of simulated time: every live worker may compute one batch.
   void step() {
     now += 0.01;
+    ++steps;
     agg->tick(now);
     for (std::size_t w = 0; w < workers.size(); ++w)
-      if (alive[w]) workers[w]->tick(now), workers[w]->step(now);
+      if (alive[w]) {
+        workers[w]->tick(now);
+        if (steps % period[w] == 0) workers[w]->step(now);
+      }
     while (!queue.empty()) {
       Message m = std::move(queue.front());
       queue.pop_front();
@@ -148,6 +156,25 @@ TEST(AggregatorRun, DeadWorkersLeasesGoToTheOthers) {
   ASSERT_TRUE(net.run());
   EXPECT_EQ(net.agg->result(), f.reference(12000));
   EXPECT_GT(net.agg->health().released, 0u);
+}
+
+// One worker ten times slower than the other (another process on its core): at the end the fast
+// one takes the back half of the slow one's unfinished leases, which the slow one then skips,
+// instead of idling until the slow one has tossed both leases it holds.
+TEST(AggregatorRun, AnIdleWorkerTakesHalfOfASlowWorkersLeaseAtTheEnd) {
+  Fixture f(20000);
+  f.cfg.min_lease = 50;  // halves down to 50 tosses: half a second of the slow worker at most
+  Net net = make_net(f, 2);
+  net.period[1] = 10;
+  ASSERT_TRUE(net.run());
+  EXPECT_EQ(net.agg->result(), f.reference(20000));
+  EXPECT_GT(net.agg->health().splits, 0u);
+  // 100 tosses per 10 ms plus 100 per 100 ms: 20000 take 1.82 s at best; 2.0 s with splitting.
+  // Without it the slow worker still holds up to 2 x 700 tosses when the fast one runs out: 2.8 s.
+  EXPECT_LT(net.now, 2.3) << net.agg->health().splits << " splits";
+  // The slow worker heard its leases shortened and skipped their moved halves: few duplicates.
+  EXPECT_LT(net.agg->health().duplicates, 2 * 100 * net.agg->health().splits);
+  EXPECT_EQ(net.workers[0]->tosses_done() + net.workers[1]->tosses_done(), 20000u + net.agg->health().duplicates);
 }
 
 TEST(AggregatorRun, LateWorkerTakesPart) {
@@ -332,3 +359,57 @@ TEST(AggregatorRun, AnAdoptedWorkerWhoseReadyWasLostRepeatsItOnRunStart) {
 
 }  // namespace
 
+
+namespace {
+
+// A worker's batches hold about WorkerConfig::batch_s of work: growing at most fourfold a batch up
+// to `batch` when tosses are cheap (fewer messages), down to 256 tosses when they are slow (a
+// heartbeat, a lease hand-over or the run's end is never a long batch away).
+TEST(AggregatorRun, BatchesHoldAboutBatchSOfWork) {
+  Fixture f(100000);
+  std::vector<int> counts;
+  worker::WorkerConfig c;
+  c.batch = 8192;
+  c.batch_s = 0.02;
+  worker::WorkerCore w(c, [&](const char* ch, const std::vector<std::uint8_t>& b) {
+    if (std::string(ch) == wire::kTossBatch) counts.push_back(wire::decode<dicesim_lcm::toss_batch>(b.data(), b.size())->count);
+  });
+  w.adopt(f.spec, f.model, 0.0);
+  dicesim_lcm::work_lease m{};
+  m.run_id = f.spec.run_id, m.worker_id = w.id(), m.lease_id = 1, m.first_index = 0, m.count = 100000;
+  const auto lease = wire::encode(m);
+  w.on_message(wire::kWorkLease, lease.data(), lease.size(), 0.0);
+  double now = 0.0;
+  for (int i = 0; i < 5; ++i, now += 0.001) ASSERT_TRUE(w.step(now));  // 1 ms a batch, whatever its size
+  EXPECT_EQ(counts, (std::vector<int>{512, 2048, 8192, 8192, 8192}));
+  counts.clear();
+  for (int i = 0; i < 2; ++i) {
+    now += 2.0;  // 2 s a batch
+    ASSERT_TRUE(w.step(now));
+  }
+  EXPECT_EQ(counts, (std::vector<int>{256, 256}));
+}
+
+// Stopping (SIGTERM from `dicesim run` once the run is over): a batch in progress ends within
+// 64 tosses and is not published.
+TEST(AggregatorRun, ACancelledWorkerStopsInsideABatch) {
+  Fixture f(10000);
+  std::atomic<bool> stop{true};
+  int batches = 0;
+  worker::WorkerConfig c;
+  c.cancel = &stop;
+  worker::WorkerCore w(c, [&](const char* ch, const std::vector<std::uint8_t>&) { batches += std::string(ch) == wire::kTossBatch; });
+  w.adopt(f.spec, f.model, 0.0);
+  dicesim_lcm::work_lease m{};
+  m.run_id = f.spec.run_id, m.worker_id = w.id(), m.lease_id = 1, m.first_index = 0, m.count = 10000;
+  const auto lease = wire::encode(m);
+  w.on_message(wire::kWorkLease, lease.data(), lease.size(), 0.0);
+  EXPECT_FALSE(w.step(0.0));
+  EXPECT_EQ(batches, 0);
+  EXPECT_EQ(w.tosses_done(), 0u);
+  stop = false;
+  EXPECT_TRUE(w.step(0.1));
+  EXPECT_EQ(batches, 1);
+}
+
+}  // namespace

@@ -65,7 +65,7 @@ void WorkerCore::on_message(std::string_view channel, const void* data, std::siz
   if (channel == wire::kRunStart) {
     if (auto m = wire::decode<dicesim_lcm::run_start>(data, len)) return on_run_start(*m, now);
   } else if (channel == wire::kWorkLease) {
-    if (auto m = wire::decode<dicesim_lcm::work_lease>(data, len)) return on_lease(*m);
+    if (auto m = wire::decode<dicesim_lcm::work_lease>(data, len)) return on_lease(*m, now);
   } else if (channel == wire::kProbabilities) {
     if (auto m = wire::decode<dicesim_lcm::probabilities>(data, len)) {
       if (run_ && m->run_id == run_->spec.run_id && m->finished == 1) end_run("finished");
@@ -105,6 +105,7 @@ void WorkerCore::start_run(wire::RunSpec spec, const DieModel* known, double now
   leases_.clear();
   last_lease_seen_ = last_done_ = 0;
   tosses_done_ = rate_n_ = 0;
+  batch_now_ = 0, last_n_ = 0;  // another run may be another fidelity
   rate_t_ = now;
   const wire::RunSpec& s = run_->spec;
   try {
@@ -130,18 +131,31 @@ void WorkerCore::start_run(wire::RunSpec spec, const DieModel* known, double now
   send_status(now);
 }
 
-void WorkerCore::on_lease(const dicesim_lcm::work_lease& m) {
+void WorkerCore::on_lease(const dicesim_lcm::work_lease& m, double now) {
   if (!run_ || !run_->model || m.run_id != run_->spec.run_id || m.worker_id != cfg_.worker_id) return;
   const std::uint64_t total = run_->spec.total;
   if (m.lease_id <= last_done_ || m.count <= 0 || m.first_index < 0 || static_cast<std::uint64_t>(m.first_index) >= total ||
-      static_cast<std::uint64_t>(m.count) > total - static_cast<std::uint64_t>(m.first_index) || leases_.size() >= 16) {
+      static_cast<std::uint64_t>(m.count) > total - static_cast<std::uint64_t>(m.first_index)) {
     ++ignored_;
     return;
   }
-  for (const Lease& l : leases_)
-    if (l.id == m.lease_id) return;
   const std::uint64_t first = static_cast<std::uint64_t>(m.first_index);
-  Lease l{m.lease_id, first, first + static_cast<std::uint64_t>(m.count)};
+  const std::uint64_t end = first + static_cast<std::uint64_t>(m.count);
+  for (auto it = leases_.begin(); it != leases_.end(); ++it) {
+    if (it->id != m.lease_id) continue;
+    // The same lease, shorter: the aggregator gave its back part to an idle worker (the run's
+    // tail). Anything else under a known id (a repeat, a longer count) changes nothing.
+    if (first == it->first && end < it->end) {
+      it->end = std::max(end, it->next);
+      if (it->next == it->end) finish_lease(it, now);  // it had already tossed up to the new end
+    }
+    return;
+  }
+  if (leases_.size() >= 16) {
+    ++ignored_;
+    return;
+  }
+  Lease l{m.lease_id, first, first, end};
   leases_.insert(std::upper_bound(leases_.begin(), leases_.end(), l, [](const Lease& a, const Lease& b) { return a.id < b.id; }),
                  l);
   last_lease_seen_ = std::max(last_lease_seen_, m.lease_id);
@@ -189,11 +203,23 @@ void WorkerCore::tick(double now) {
 }
 
 bool WorkerCore::step(double now) {
-  if (!run_ || !run_->model || leases_.empty()) return false;
+  if (!run_ || !run_->model || leases_.empty()) {
+    last_n_ = 0;  // idle: the next step's wait is not a batch's cost
+    return false;
+  }
   const DieModel& model = *run_->model;
   const wire::RunSpec& spec = run_->spec;
   Lease& l = leases_.front();
-  const std::uint64_t n = std::min<std::uint64_t>(static_cast<std::uint64_t>(cfg_.batch), l.end - l.next);
+  // Steps follow each other while there is work: the time since the last one is its batch's
+  // cost. Sized to batch_s of work, growing at most fourfold a step; never below 256 tosses.
+  if (batch_now_ == 0) batch_now_ = std::min(cfg_.batch, 512);
+  if (last_n_ > 0 && now > last_step_) {
+    const double fit = cfg_.batch_s * static_cast<double>(last_n_) / (now - last_step_);
+    batch_now_ = std::min(cfg_.batch, static_cast<int>(std::max(256.0, std::min(fit, 4.0 * batch_now_))));
+  }
+  const std::uint64_t n = std::min<std::uint64_t>(static_cast<std::uint64_t>(batch_now_), l.end - l.next);
+  last_step_ = now;
+  last_n_ = n;
 
   // Bounce-state budget for this batch: a token bucket refilled at max_trace_per_s.
   trace_tokens_ = std::min(cfg_.max_trace_per_s, trace_tokens_ + (now - trace_t_) * cfg_.max_trace_per_s);
@@ -212,6 +238,7 @@ bool WorkerCore::step(double now) {
   b.n_corrected = 0;
   std::vector<BounceRecord> records;
   for (std::uint64_t k = 0; k < n; ++k) {
+    if (k % 64 == 63 && cfg_.cancel && cfg_.cancel->load(std::memory_order_relaxed)) return false;
     const std::uint64_t i = l.next + k;
     const bool traced = spec.trace_every > 0 && i % static_cast<std::uint64_t>(spec.trace_every) == 0;
     records.clear();
@@ -264,12 +291,14 @@ bool WorkerCore::step(double now) {
   send(wire::kTossBatch, wire::encode(b));
   l.next += n;
   tosses_done_ += n;
-  if (l.next == l.end) {
-    last_done_ = l.id;
-    leases_.pop_front();
-    send_status(now);  // "done with that one": the aggregator may re-lease what it did not get
-  }
+  if (l.next == l.end) finish_lease(leases_.begin(), now);
   return true;
+}
+
+void WorkerCore::finish_lease(std::deque<Lease>::iterator it, double now) {
+  last_done_ = it->id;
+  leases_.erase(it);
+  send_status(now);  // "done with that one": the aggregator may re-lease what it did not get
 }
 
 namespace {

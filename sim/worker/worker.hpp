@@ -25,7 +25,10 @@ namespace dicesim::worker {
 struct WorkerConfig {
   std::int64_t worker_id = 0;        // 0: pick a random one
   std::int64_t only_run = 0;         // non-zero: serve only this run id
-  int batch = wire::kMaxBatch;       // tosses per toss_batch: the most a message holds (fewer wake-ups)
+  int batch = wire::kDefaultBatch;   // tosses per toss_batch at most (fewer messages, fewer wake-ups)
+  // ... and about this much work at most: a batch shrinks (not below 256 tosses) for slow
+  // fidelities, so that heartbeats, lease hand-overs and the run's end are never a long batch away.
+  double batch_s = 0.05;
   double heartbeat_s = 0.2;
   double run_silence_s = 5.0;        // no run_start for this long: the run is gone
   double max_trace_per_s = 2000.0;   // bounce_state messages per second at most (publishers pace themselves)
@@ -34,6 +37,9 @@ struct WorkerConfig {
   // The run key (messages/auth.hpp): every message out is sealed, every message in must open
   // (else it is dropped and counted: unauthenticated()). Empty: no authentication.
   std::vector<std::uint8_t> key;
+  // Set from a signal handler: a batch in progress stops within 64 tosses, unpublished (the
+  // process is stopping; its lease goes elsewhere if the run still needs it).
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 class WorkerCore {
@@ -68,13 +74,15 @@ class WorkerCore {
   };
   struct Lease {
     std::int64_t id;
-    std::uint64_t next, end;
+    std::uint64_t first, next, end;
   };
 
   void on_run_start(const dicesim_lcm::run_start& m, double now);
   // Takes up `spec` (run_start's, or adopt's); `known`: its model, already compiled (else compiled here).
   void start_run(wire::RunSpec spec, const DieModel* known, double now);
-  void on_lease(const dicesim_lcm::work_lease& m);
+  void on_lease(const dicesim_lcm::work_lease& m, double now);
+  // Every batch of the lease is out: drop it and tell the aggregator.
+  void finish_lease(std::deque<Lease>::iterator it, double now);
   // `final`: the run is over for good (finished, replaced); otherwise (its aggregator went
   // silent) the same run may be served again when its run_start comes back (a resumed aggregator).
   void end_run(const char* why, bool final = true);
@@ -92,6 +100,9 @@ class WorkerCore {
   wire::Sealer sealer_;
   bool told_key_ = false;  // logged once that sealed / unsealed runs were heard
   int runs_finished_ = 0;
+  int batch_now_ = 0;                    // the next batch's size (batch_s at the measured speed)
+  double last_step_ = -1.0;              // when the previous batch began (its size: last_n_)
+  std::uint64_t last_n_ = 0;
   double last_status_ = -1e9;
   double rate_ = 0.0, rate_t_ = 0.0;
   std::uint64_t rate_n_ = 0;

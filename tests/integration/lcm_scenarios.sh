@@ -286,10 +286,10 @@ case "$scenario" in
     # Bound: the work done after the checkpoint the resume read was taken — its age at the resume
     # (about one checkpoint interval plus the restart gap; more when fsync is slow) — plus one
     # interval of slack for the rate's ups and downs, plus the leases the workers had queued
-    # (2 each, at most 8192 tosses), at the run's average throughput.
+    # (2 each, at most AggregatorConfig::max_lease = 32768 tosses), at the run's average throughput.
     rate=$((n * 1000000000 / (t1 - t0)))
     age_ms=$(grep -oE 'checkpoint [0-9.]+ s old' "$work/agg.err" | grep -oE '[0-9.]+' | awk '{ printf "%d", $1 * 1000 }')
-    bound=$((rate * (age_ms + 1000) / 1000 + 2 * 2 * 8192))
+    bound=$((rate * (age_ms + 1000) / 1000 + 2 * 2 * 32768))
     echo "aggregator killed and resumed: $twice tosses computed twice (bound $bound: checkpoint $age_ms ms old at the resume + 1 s, at $rate tosses/s, + queued leases)"
     [ -n "$twice" ] && [ "$twice" -le "$bound" ] || fail "tosses computed twice: '$twice', more than $bound"
     ;;
