@@ -324,6 +324,31 @@ TEST(CylinderImpulse, RollingResistanceOpposesOnlyTheRoll) {
   EXPECT_NEAR(s.omega.x(), 0.0, 1e-18);
 }
 
+// The quarter tossed onto a table (scenes/coins/quarter-table.toml): a rim's lowest point is not a
+// material point, and the stepper used to let it sink below the floor (by up to 0.1 mm a step,
+// accumulating to millimetres in 2/3 of the tosses, until both rims were under the floor and the
+// support solve on {both rims' lowest points} of a tilted coin did not converge: 711 in 10^4).
+// Now no support solve is unconverged and every toss ends with its rims within the touch tolerance
+// of the floor; what the steps leave deeper is lifted and counted (overlap_fixes: the slapping
+// rim, rim_support in contact_stepper.cpp, about 5 a toss, an open item).
+TEST(CylinderImpulse, QuarterRimsStayOnTheFloorWithConvergedSolves) {
+  const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter-table.toml"));
+  const int n = 200;
+  std::uint64_t unconverged = 0, fixes = 0;
+  for (int i = 0; i < n; ++i) {
+    RigidState end;
+    TossProbe probe;
+    probe.final_state = &end;
+    const TossResult r = toss(m, 1, static_cast<std::uint64_t>(i), &probe);
+    ASSERT_EQ(r.status, TossStatus::Settled) << i;
+    unconverged += r.corrections.pgs_unconverged;
+    fixes += r.corrections.overlap_fixes;
+    EXPECT_GE(end.position.z() + rim_lowest(m, end.R), -1e-7 * m.bounding_radius) << "toss " << i;
+  }
+  EXPECT_EQ(unconverged, 0u);
+  EXPECT_LE(fixes, 8u * n);  // counted, not yet 0 (1045 in these 200)
+}
+
 TEST(CylinderImpulse, EdgeGrowsWithThickness) {
   SoftTable soft;
   double last = -1.0;
@@ -343,8 +368,9 @@ TEST(CylinderPaperAndStepped, TossesSettleAndReadTheRimsModel) {
   const Tally stepped =
       run(coin_model(0.01, 0.004, std::string(kTable) + "[sim]\nfidelity = \"stepped\"\nstep = 5e-4\n"), 40);
   EXPECT_LE(stepped.unresolved, 1);
-  // Unconverged contact solves happen (counted, reported); not in most tosses.
-  EXPECT_LE(stepped.corrections, 4);
+  // Corrections happen (counted, reported): since the rims are kept on the floor, the lifts of a
+  // slapping rim (overlap_fixes, contact_stepper.cpp rim_support), in 6 of these 40 tosses.
+  EXPECT_LE(stepped.corrections, 8);
 }
 
 // Rest soundness: when `impulse` says settled, continued contact dynamics never name another
