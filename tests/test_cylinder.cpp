@@ -282,8 +282,12 @@ TEST(CylinderImpulse, FairThickCoinHeadsEqualsTails) {
   EXPECT_GT(t.edge, 0);
 }
 
+// Seed 4: rolling resistance that also resisted tipping (it opposed the whole horizontal angular
+// velocity) held a slowly rolling disc upright, within its 1.5 deg edge basin, until it stopped:
+// 8 discs on edge in these 1000 tosses (2-8 in 1000 at seeds 1-5); the roll alone resisted, 0 at
+// every one of those seeds.
 TEST(CylinderImpulse, FlatDiscNeverOnEdgeLongRodAlmostAlways) {
-  const Tally disc = run(coin_model(0.015, 0.0008, std::string(kTable) + "[sim]\nfidelity = \"impulse\"\n"), 1000);
+  const Tally disc = run(coin_model(0.015, 0.0008, std::string(kTable) + "[sim]\nfidelity = \"impulse\"\n"), 1000, 4);
   EXPECT_LE(disc.unresolved, 2);
   EXPECT_EQ(disc.edge, 0);
   const Tally rod = run(coin_model(0.004, 0.08, "[throw.height]\nmean = 0.3\nsd = 0.05\n[throw.velocity]\nsd = 0.3\n"
@@ -291,6 +295,58 @@ TEST(CylinderImpulse, FlatDiscNeverOnEdgeLongRodAlmostAlways) {
                         500);
   EXPECT_LE(rod.unresolved, 2);
   EXPECT_GE(rod.edge, 0.97 * rod.n()) << rod.heads << " " << rod.tails << " " << rod.edge;
+}
+
+// Rolling resistance opposes the roll only: a disc upright on its edge (axis along x) that tips
+// (rotation about y, the rim's tangent at the contact) or pivots (about z) keeps that motion; its
+// roll (about the axis) is slowed by at most rolling_resistance * N / (the roll's moment of inertia)
+// and never reversed.
+TEST(CylinderImpulse, RollingResistanceOpposesOnlyTheRoll) {
+  const DieModel m = coin_model(0.015, 0.0008);
+  RigidState s;
+  s.R = Eigen::Quaterniond::FromTwoVectors(m.rims.axis, Vec3::UnitX()).toRotationMatrix();  // upright
+  s.position = Vec3(0.0, 0.0, -rim_lowest(m, s.R));
+  ContactSet c;
+  c.n = 2;
+  c.vertex[0] = 0;
+  c.vertex[1] = 3;
+  const double N = 1e-3;
+  s.omega = Vec3(0.0, 0.7, 0.3);  // tipping and pivoting
+  apply_rolling_resistance(m, s, c, N);
+  EXPECT_EQ(s.omega, Vec3(0.0, 0.7, 0.3));
+  s.omega = Vec3(5.0, 0.7, 0.0);  // rolling and tipping
+  apply_rolling_resistance(m, s, c, N);
+  const double I_axis = m.rims.axis.dot(m.principal_moments.cwiseProduct(m.rims.axis));
+  EXPECT_NEAR(s.omega.x(), 5.0 - 3e-4 * N / I_axis, 1e-9);
+  EXPECT_NEAR(s.omega.y(), 0.7, 1e-12);
+  s.omega = Vec3(1e-6, 0.0, 0.0);  // a roll it can stop: stopped, not reversed
+  apply_rolling_resistance(m, s, c, N);
+  EXPECT_NEAR(s.omega.x(), 0.0, 1e-18);
+}
+
+// The quarter tossed onto a table (scenes/coins/quarter-table.toml): a rim's lowest point is not a
+// material point, and the stepper used to let it sink below the floor (by up to 0.1 mm a step,
+// accumulating to millimetres in 2/3 of the tosses, until both rims were under the floor and the
+// support solve on {both rims' lowest points} of a tilted coin did not converge: 711 in 10^4).
+// Now no support solve is unconverged and every toss ends with its rims within the touch tolerance
+// of the floor; what the steps leave deeper is lifted and counted (overlap_fixes: the slapping
+// rim, rim_support in contact_stepper.cpp, about 5 a toss, an open item).
+TEST(CylinderImpulse, QuarterRimsStayOnTheFloorWithConvergedSolves) {
+  const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter-table.toml"));
+  const int n = 200;
+  std::uint64_t unconverged = 0, fixes = 0;
+  for (int i = 0; i < n; ++i) {
+    RigidState end;
+    TossProbe probe;
+    probe.final_state = &end;
+    const TossResult r = toss(m, 1, static_cast<std::uint64_t>(i), &probe);
+    ASSERT_EQ(r.status, TossStatus::Settled) << i;
+    unconverged += r.corrections.pgs_unconverged;
+    fixes += r.corrections.overlap_fixes;
+    EXPECT_GE(end.position.z() + rim_lowest(m, end.R), -1e-7 * m.bounding_radius) << "toss " << i;
+  }
+  EXPECT_EQ(unconverged, 0u);
+  EXPECT_LE(fixes, 8u * n);  // counted, not yet 0 (1045 in these 200)
 }
 
 TEST(CylinderImpulse, EdgeGrowsWithThickness) {
@@ -312,8 +368,9 @@ TEST(CylinderPaperAndStepped, TossesSettleAndReadTheRimsModel) {
   const Tally stepped =
       run(coin_model(0.01, 0.004, std::string(kTable) + "[sim]\nfidelity = \"stepped\"\nstep = 5e-4\n"), 40);
   EXPECT_LE(stepped.unresolved, 1);
-  // Unconverged contact solves happen (counted, reported); not in most tosses.
-  EXPECT_LE(stepped.corrections, 4);
+  // Corrections happen (counted, reported): since the rims are kept on the floor, the lifts of a
+  // slapping rim (overlap_fixes, contact_stepper.cpp rim_support), in 6 of these 40 tosses.
+  EXPECT_LE(stepped.corrections, 8);
 }
 
 // Rest soundness: when `impulse` says settled, continued contact dynamics never name another

@@ -94,17 +94,19 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   if (impact_) a.imp = imp_;
   a.next.n = 0;
   s.velocity.z() -= m.gravity * d;
-  if (c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
-  if (m.curved() && c.n > 0) apply_rolling_resistance(m, s, c, a.sup.normal_impulse);
-
-  // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact).
-  const Vec3 L = Iw_start_ * s.omega;  // s.R is s0.R in every trial
   // Built in place (the full step's is kept for model_G; the object is large, so no copies). A
-  // trial of a step without contact has the full step's rotation exactly (the same s0.R and, with
-  // no impulse, the same angular momentum): it is reused.
-  const TorqueFreeRotation& rot = !full && c.n == 0 && full_rot_
-                                      ? *full_rot_
-                                      : (full ? full_rot_ : trial_rot_).emplace(m.principal_moments, s.R, L);
+  // curved die's support solve builds its own (rim_support: the rotation is part of its search).
+  std::optional<TorqueFreeRotation>& slot = full ? full_rot_ : trial_rot_;
+  const bool built = m.curved() && c.n > 0 && rim_support(s, c, d, mechanical_energy(m, s0), a, slot);
+  if (!m.curved() && c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
+
+  // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact). A trial of
+  // a step without contact has the full step's rotation exactly (the same s0.R and, with no
+  // impulse, the same angular momentum): it is reused.
+  const TorqueFreeRotation& rot = built                             ? *slot
+                                  : !full && c.n == 0 && full_rot_ ? *full_rot_
+                                                                    : slot.emplace(m.principal_moments, s.R,
+                                                                                   Vec3(Iw_start_ * s.omega));
   rot_start_ = s.R;
   const Vec3 p = s.position, v = s.velocity;
   // Every body point lies within the bounding radius of the COM (|bottom row| = 1 to rounding, far
@@ -132,6 +134,106 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   s.position = p + d * v;
   s.R = R_end;
   s.omega = w;
+}
+
+namespace {
+
+// World height, relative to the COM, of the lowest point of rim `rim` (0: the +axis rim, 1: the
+// other) from the orientation's bottom row (rim.hpp's rim_point for feature 3 rim, in closed form).
+double rim_low_z(const DieModel& m, const Vec3& z_row, int rim) {
+  const double kz = z_row.dot(m.rims.axis);
+  return z_row.dot(m.rims.centre) + (rim == 0 ? m.rims.half : -m.rims.half) * kz -
+         m.rims.radius * std::sqrt(std::max(0.0, 1.0 - kz * kz)) - m.rounding;
+}
+
+}  // namespace
+
+bool FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
+                               std::optional<TorqueFreeRotation>& rot) {
+  // A rim's lowest point is not a material point: the plastic solve stops the normal velocity of
+  // the material point there, but over the step the rim's lowest point moves along the rim and
+  // can end below the floor (a wobbling coin's sank by up to 0.1 mm a step, and it accumulated
+  // to millimetres). So the solve asks the touching points for the upward speed b that brings
+  // the touching rims' lowest points back to the floor at the step's end: v_n >= b instead of
+  // v_n >= 0 (the same solve with the velocity shifted by -b e_z, then restored: tangential
+  // velocities and friction are unchanged by the shift), b the root of the exact gap at the
+  // step's end (the step's own free motion) in b, bracketed, by Illinois: the gap grows with b at
+  // rate d to first order (the shift raises every point by b d; only the solve's change of the
+  // spin acts on the sinking). The constraint's centripetal part, as an impulse. b = 0 (the plain
+  // solve) whenever the rims end the step on the floor without it, and whenever the plain solve
+  // does not push (the touching material point leaves the floor): then the sinking is another
+  // part of the rim coming down (a coin slapping flat), and asking the leaving point for more
+  // upward speed would push where nothing touches and gain energy (up to 70 % of a step's in
+  // trials); step() lifts that residual instead, counted (overlap_fixes).
+  const DieModel& m = *m_;
+  const RigidState base = s;
+  bool rim_in[2] = {false, false};
+  for (int i = 0; i < c.n; ++i) rim_in[c.vertex[i] < 3 ? 0 : 1] = true;
+  int sweeps = 0;
+  const auto solve = [&](double b) {
+    s = base;
+    s.velocity.z() -= b;
+    a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next);
+    s.velocity.z() += b;
+    sweeps += a.sup.iterations;
+    apply_rolling_resistance(m, s, c, a.sup.normal_impulse);
+    rot.emplace(m.principal_moments, s.R, world_inertia(m, s.R) * s.omega);
+    const Vec3 z_row = rot->bottom_row(d);
+    double gap = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < 2; ++r)
+      if (rim_in[r]) gap = std::min(gap, s.position.z() + s.velocity.z() * d + rim_low_z(m, z_row, r));
+    return gap;
+  };
+  double lo = 0.0, g_lo = solve(0.0);
+  if (!(d > 0.0) || g_lo >= -touch_tol_ || !(a.sup.normal_impulse > 0.0)) {
+    a.sup.iterations = sweeps;
+    return true;
+  }
+  // Bracket: from the first-order guess, doubling (every point rises by at least ~b d for large b).
+  double hi = -g_lo / d, g_hi = solve(hi);
+  for (int k = 0; k < 8 && g_hi < -touch_tol_; ++k) {
+    lo = hi, g_lo = g_hi;
+    hi *= 2.0;
+    g_hi = solve(hi);
+  }
+  int side = 0;
+  double b = hi, g = g_hi;
+  for (int k = 0; k < 12 && std::abs(g) > touch_tol_ && g_hi > 0.0; ++k) {
+    b = hi - g_hi * (hi - lo) / (g_hi - g_lo);
+    if (!(b > lo && b < hi)) b = 0.5 * (lo + hi);
+    g = solve(b);
+    if (g < 0.0) {
+      lo = b, g_lo = g;
+      if (side == -1) g_hi *= 0.5;
+      side = -1;
+    } else {
+      hi = b, g_hi = g;
+      if (side == 1) g_lo *= 0.5;
+      side = 1;
+    }
+  }
+  if (std::abs(g) > touch_tol_ && b != hi) {  // not converged: the bracket's end above the floor
+    b = hi;
+    solve(b);
+  }
+  // No step may gain mechanical energy (the rest rules rely on it, rest.hpp): the step's end
+  // energy (the free motion keeps the kinetic energy; the COM rises by v_z d) against its start's,
+  // e_start. If the bias would gain, the largest b that does not (bisection; the plain solve never
+  // gains), and step() lifts the rest of the sinking, counted.
+  const auto gains = [&] {
+    return kinetic_energy(m, s) + m.mass * m.gravity * (s.position.z() + s.velocity.z() * d) > e_start;
+  };
+  if (gains()) {
+    double ok = 0.0, bad = b;
+    for (int k = 0; k < 20; ++k) {
+      const double mid = 0.5 * (ok + bad);
+      solve(mid);
+      (gains() ? bad : ok) = mid;
+    }
+    solve(ok);
+  }
+  a.sup.iterations = sweeps;
+  return true;
 }
 
 double FixedStepper::model_root(const ContactSet& c, double miss, double lo, double hi, double f_lo, double f_hi,
@@ -345,6 +447,18 @@ int FixedStepper::step(RigidState& s) {
   }
   dt_ = dt;
   max_energy_gain = std::max(max_energy_gain, relative_gain(E0, mechanical_energy(m, s)));
+  if (m.curved()) {
+    // The rims end every step within the touch tolerance of the floor or above it; where the step
+    // left them deeper (a slapping rim, whose plain solve does not push, rim_support; a bias not
+    // bracketed; a search out of trials) the COM is lifted by the residual, counted. (The energy
+    // check above is of the step itself; the lift's m g dz is that counted correction.)
+    const double pen = -(s.position.z() + rim_lowest(m, s.R));
+    max_penetration = std::max(max_penetration, pen);
+    if (pen > touch_tol_) {
+      s.position.z() += pen;
+      ++corrections.overlap_fixes;
+    }
+  }
   return c.n;
 }
 
@@ -369,6 +483,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->steps += steps;
       stats->located += st.located;
       stats->max_energy_gain = std::max(stats->max_energy_gain, st.max_energy_gain);
+      stats->max_penetration = std::max(stats->max_penetration, st.max_penetration);
     }
     return out;
   };

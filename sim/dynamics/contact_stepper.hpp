@@ -12,7 +12,9 @@
 // Energy: no step gains mechanical energy E = kinetic + m g z_com (the rotation is exact, a step
 // without contact loses m g^2 h^2 / 2, the plastic solve after gravity's kick loses at least
 // (F - m g h)^2 / 2m with F its normal impulse, and no impact gains). `max_energy_gain` records
-// the largest relative gain seen, for the tests.
+// the largest relative gain seen, for the tests. (A curved die's rolling support, which asks the
+// rim for the upward speed that keeps its lowest point on the floor, is capped to keep this too:
+// rim_support.)
 #pragma once
 
 #include <optional>
@@ -69,6 +71,7 @@ class FixedStepper {
   std::uint64_t sweeps = 0;       // Gauss-Seidel sweeps of every solve so far
   std::uint64_t located = 0;      // steps shortened to a new contact's instant
   double max_energy_gain = 0.0;   // largest relative gain of one impact's kinetic or one step's mechanical energy
+  double max_penetration = 0.0;   // curved dice: deepest lowest point below the floor at a step's end (m)
 
  private:
   // One trial step of length d from s0 with contact set c; full: the step of length h, whose
@@ -81,6 +84,11 @@ class FixedStepper {
     double G = 0.0;  // lowest height at the step's end over corners not in c
   };
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
+  // A curved die's support solve for a step of length d (gravity's kick already in s): the plastic
+  // solve, rolling resistance, and the touching rims' lowest points held on the floor at the
+  // step's end (contact_stepper.cpp). Leaves rot built for s's free motion; returns true.
+  bool rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
+                   std::optional<TorqueFreeRotation>& rot);
   // The model of G(d) from the full step's free motion: its lowest new corner at t, raised by what
   // the smaller gravity kick of a step of length t changes, g (h - t) t. Exact for a step without
   // contact (the rotation is the same); with contact the solve absorbs part of the kick.
@@ -134,6 +142,7 @@ struct StepperStats {
   std::uint64_t steps = 0;
   std::uint64_t located = 0;  // steps shortened to a new contact's instant
   double max_energy_gain = 0.0;
+  double max_penetration = 0.0;  // curved dice: deepest lowest point below the floor at a step's end (m)
 };
 
 // Steps from (s, t) until the die must come to rest (sim/rest.hpp), the time cap, the impact cap

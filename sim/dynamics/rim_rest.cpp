@@ -135,17 +135,23 @@ double rim_lowest_excluding(const DieModel& m, const Mat3& R, const ContactSet& 
 
 void apply_rolling_resistance(const DieModel& m, RigidState& s, const ContactSet& c, double normal_impulse) {
   if (c.n == 0 || !(normal_impulse > 0.0)) return;
-  const Vec3 wh(s.omega.x(), s.omega.y(), 0.0);
-  const double w = wh.norm();
-  if (w <= 0.0) return;
+  // The roll: rotation about the horizontal projection of the axis (the horizontal perpendicular
+  // to the rim's tangent at its lowest point), which moves the contact along the floor. Tipping
+  // (about that tangent) and pivoting (about the vertical) move no contact and are not resisted.
+  const Vec3 K = s.R * m.rims.axis;
+  const Vec3 kh(K.x(), K.y(), 0.0);
+  const double nk = kh.norm();
+  if (nk <= 1e-9) return;  // lying flat: nothing to roll on
+  const Vec3 u = kh / nk;
+  const double w = s.omega.dot(u);
+  if (w == 0.0) return;
   double delta = 0.0;
   for (int i = 0; i < c.n; ++i) delta += m.vertex_rolling[static_cast<std::size_t>(c.vertex[i])];
   delta /= c.n;
   if (delta <= 0.0) return;
-  const Vec3 u = wh / w;
   const Vec3 inv_u = s.R * (s.R.transpose() * u).cwiseQuotient(m.principal_moments);  // I_w^-1 u
-  const double lam = std::min(delta * normal_impulse, w / u.dot(inv_u));
-  s.omega -= lam * inv_u;
+  const double lam = std::min(delta * normal_impulse, std::abs(w) / u.dot(inv_u));
+  s.omega -= (w > 0.0 ? lam : -lam) * inv_u;
 }
 
 }  // namespace dicesim

@@ -34,8 +34,10 @@ int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak);
 double rim_lowest_excluding(const DieModel& m, const Mat3& R, const ContactSet& c);
 
 // Rolling resistance for one step with contact set c that carried normal impulse `normal_impulse`:
-// an angular impulse rolling_resistance * normal_impulse against the horizontal angular velocity
-// (the roll), capped so that it stops the roll at most (never reverses it: energy only falls).
+// an angular impulse rolling_resistance * normal_impulse against the roll (the angular velocity
+// about the horizontal projection of the axis), capped so that it stops the roll at most (never
+// reverses it: energy only falls). Tipping and pivoting are not resisted: resisting the tipping
+// rate too (as this once did) held slowly rolling thin discs upright until they stopped.
 void apply_rolling_resistance(const DieModel& m, RigidState& s, const ContactSet& c, double normal_impulse);
 
 }  // namespace dicesim
