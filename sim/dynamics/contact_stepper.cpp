@@ -7,6 +7,7 @@
 #include "sim/dynamics/friction_impact.hpp"
 #include "sim/dynamics/rest.hpp"
 #include "sim/dynamics/rim_rest.hpp"
+#include "sim/illinois.hpp"
 
 namespace dicesim {
 
@@ -196,24 +197,15 @@ bool FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, dou
     hi *= 2.0;
     g_hi = solve(hi);
   }
-  int side = 0;
+  Illinois br{lo, g_lo, hi, g_hi};
   double b = hi, g = g_hi;
-  for (int k = 0; k < 12 && std::abs(g) > touch_tol_ && g_hi > 0.0; ++k) {
-    b = hi - g_hi * (hi - lo) / (g_hi - g_lo);
-    if (!(b > lo && b < hi)) b = 0.5 * (lo + hi);
+  for (int k = 0; k < 12 && std::abs(g) > touch_tol_ && br.f_hi > 0.0; ++k) {
+    b = br.next();
     g = solve(b);
-    if (g < 0.0) {
-      lo = b, g_lo = g;
-      if (side == -1) g_hi *= 0.5;
-      side = -1;
-    } else {
-      hi = b, g_hi = g;
-      if (side == 1) g_lo *= 0.5;
-      side = 1;
-    }
+    br.update(b, g, /*lo_side=*/g < 0.0);
   }
-  if (std::abs(g) > touch_tol_ && b != hi) {  // not converged: the bracket's end above the floor
-    b = hi;
+  if (std::abs(g) > touch_tol_ && b != br.hi) {  // not converged: the bracket's end above the floor
+    b = br.hi;
     solve(b);
   }
   // No step may gain mechanical energy (the rest rules rely on it, rest.hpp): the step's end
@@ -238,23 +230,14 @@ bool FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, dou
 
 double FixedStepper::model_root(const ContactSet& c, double miss, double lo, double hi, double f_lo, double f_hi,
                                 double& g_model) const {
-  int side = 0;
+  Illinois br{lo, f_lo, hi, f_hi};
   double mid = hi;
-  for (int it = 0; it < 100 && hi - lo > 1e-15 * h_; ++it) {
-    mid = hi - f_hi * (hi - lo) / (f_hi - f_lo);
-    if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
+  for (int it = 0; it < 100 && br.hi - br.lo > 1e-15 * h_; ++it) {
+    mid = br.next();
     g_model = model_G(c, mid);
     const double f = corrected(g_model, miss, mid);
     if (std::abs(f) <= 1e-3 * touch_tol_) break;
-    if (f > 0.0) {
-      lo = mid, f_lo = f;
-      if (side == -1) f_hi *= 0.5;
-      side = -1;
-    } else {
-      hi = mid, f_hi = f;
-      if (side == 1) f_lo *= 0.5;
-      side = 1;
-    }
+    br.update(mid, f, /*lo_side=*/f > 0.0);
   }
   return mid;
 }
