@@ -98,7 +98,8 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   // Built in place (the full step's is kept for model_G; the object is large, so no copies). A
   // curved die's support solve builds its own (rim_support: the rotation is part of its search).
   std::optional<TorqueFreeRotation>& slot = full ? full_rot_ : trial_rot_;
-  const bool built = m.curved() && c.n > 0 && rim_support(s, c, d, mechanical_energy(m, s0), a, slot);
+  const bool built = m.curved() && c.n > 0;
+  if (built) rim_support(s, c, d, mechanical_energy(m, s0), a, slot);
   if (!m.curved() && c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
 
   // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact). A trial of
@@ -149,7 +150,7 @@ double rim_low_z(const DieModel& m, const Vec3& z_row, int rim) {
 
 }  // namespace
 
-bool FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
+void FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
                                std::optional<TorqueFreeRotation>& rot) {
   // A rim's lowest point is not a material point: the plastic solve stops the normal velocity of
   // the material point there, but over the step the rim's lowest point moves along the rim and
@@ -188,7 +189,7 @@ bool FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, dou
   double lo = 0.0, g_lo = solve(0.0);
   if (!(d > 0.0) || g_lo >= -touch_tol_ || !(a.sup.normal_impulse > 0.0)) {
     a.sup.iterations = sweeps;
-    return true;
+    return;
   }
   // Bracket: from the first-order guess, doubling (every point rises by at least ~b d for large b).
   double hi = -g_lo / d, g_hi = solve(hi);
@@ -225,7 +226,6 @@ bool FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, dou
     solve(ok);
   }
   a.sup.iterations = sweeps;
-  return true;
 }
 
 double FixedStepper::model_root(const ContactSet& c, double miss, double lo, double hi, double f_lo, double f_hi,

@@ -86,8 +86,8 @@ class FixedStepper {
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
   // A curved die's support solve for a step of length d (gravity's kick already in s): the plastic
   // solve, rolling resistance, and the touching rims' lowest points held on the floor at the
-  // step's end (contact_stepper.cpp). Leaves rot built for s's free motion; returns true.
-  bool rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
+  // step's end (contact_stepper.cpp). Leaves rot built for s's free motion.
+  void rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
                    std::optional<TorqueFreeRotation>& rot);
   // The model of G(d) from the full step's free motion: its lowest new corner at t, raised by what
   // the smaller gravity kick of a step of length t changes, g (h - t) t. Exact for a step without
