@@ -25,7 +25,8 @@
 //     again, in the discs |P_t| <= mu k P_n, minimising the kinetic energy (Coulomb with
 //     maximal dissipation against the restitution's slip; on an edge, two points, solved exactly by
 //     its active sets (both stick / one slides / both slide) and verified against the KKT
-//     conditions, Gauss-Seidel and Newton only if no case verifies). Mixed materials: one e for the impact,
+//     conditions, Gauss-Seidel and Newton only if no case verifies; the same exact solve when those
+//     fail and only two points carry friction). Mixed materials: one e for the impact,
 //     sum w_i e_i / sum w_i with w_i the approach speed of point i before the impact, a function of
 //     the state alone (not of the Gauss-Seidel split of a face's load, which is not unique).
 //  So dE = dE_c + e^2 E_c + (friction <= 0) <= (1 - e^2) dE_c <= 0 for any e in [0, 1], any number
