@@ -161,7 +161,9 @@ void FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, dou
   // velocities and friction are unchanged by the shift), b the root of the exact gap at the
   // step's end (the step's own free motion) in b, bracketed, by Illinois: the gap grows with b at
   // rate d to first order (the shift raises every point by b d; only the solve's change of the
-  // spin acts on the sinking). The constraint's centripetal part, as an impulse. b = 0 (the plain
+  // spin acts on the sinking). The constraint's centripetal part, as an impulse. The same from
+  // above when the plain solve leaves the rims above the floor at the step's end (b < 0: less
+  // push, down to none). b = 0 (the plain
   // solve) whenever the rims end the step on the floor without it, and whenever the plain solve
   // does not push (the touching material point leaves the floor): then the sinking is another
   // part of the rim coming down (a coin slapping flat), and asking the leaving point for more
@@ -186,28 +188,59 @@ void FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, dou
       if (rim_in[r]) gap = std::min(gap, s.position.z() + s.velocity.z() * d + rim_low_z(m, z_row, r));
     return gap;
   };
-  double lo = 0.0, g_lo = solve(0.0);
-  if (!(d > 0.0) || g_lo >= -touch_tol_ || !(a.sup.normal_impulse > 0.0)) {
+  const double g0 = solve(0.0);
+  if (!(d > 0.0) || std::abs(g0) <= touch_tol_ || !(a.sup.normal_impulse > 0.0)) {
     a.sup.iterations = sweeps;
     return;
   }
-  // Bracket: from the first-order guess, doubling (every point rises by at least ~b d for large b).
-  double hi = -g_lo / d, g_hi = solve(hi);
-  for (int k = 0; k < 8 && g_hi < -touch_tol_; ++k) {
-    lo = hi, g_lo = g_hi;
-    hi *= 2.0;
-    g_hi = solve(hi);
-  }
-  Illinois br{lo, g_lo, hi, g_hi};
-  double b = hi, g = g_hi;
-  for (int k = 0; k < 12 && std::abs(g) > touch_tol_ && br.f_hi > 0.0; ++k) {
-    b = br.next();
-    g = solve(b);
-    br.update(b, g, /*lo_side=*/g < 0.0);
-  }
-  if (std::abs(g) > touch_tol_ && b != br.hi) {  // not converged: the bracket's end above the floor
-    b = br.hi;
-    solve(b);
+  double b = 0.0;
+  if (g0 < 0.0) {
+    // Sinking. Bracket: from the first-order guess, doubling (every point rises by at least ~b d
+    // for large b).
+    double lo = 0.0, g_lo = g0, hi = -g0 / d, g_hi = solve(hi);
+    for (int k = 0; k < 8 && g_hi < -touch_tol_; ++k) {
+      lo = hi, g_lo = g_hi;
+      hi *= 2.0;
+      g_hi = solve(hi);
+    }
+    Illinois br{lo, g_lo, hi, g_hi};
+    b = hi;
+    double g = g_hi;
+    for (int k = 0; k < 12 && std::abs(g) > touch_tol_ && br.f_hi > 0.0; ++k) {
+      b = br.next();
+      g = solve(b);
+      br.update(b, g, /*lo_side=*/g < 0.0);
+    }
+    if (std::abs(g) > touch_tol_ && b != br.hi) {  // not converged: the bracket's end above the floor
+      b = br.hi;
+      solve(b);
+    }
+  } else {
+    // Rising: the plain solve pushed harder than the rim needs to stay on the floor (the contact
+    // point's centripetal acceleration, -w x (w x r), points up toward the COM, and over the step it
+    // lifts the point by about w^2 r h^2 / 2; the rolling coin hopped off the floor every other
+    // step). The same constraint from above: v_n >= b with b < 0, the push reduced until the
+    // rims end the step on the floor, or no push at all (then the die really leaves the floor).
+    double hi = 0.0, g_hi = g0, lo = -g0 / d, g_lo = solve(lo);
+    for (int k = 0; k < 8 && g_lo > touch_tol_ && a.sup.normal_impulse > 0.0; ++k) {
+      hi = lo, g_hi = g_lo;
+      lo *= 2.0;
+      g_lo = solve(lo);
+    }
+    b = lo;
+    if (g_lo < -touch_tol_) {
+      Illinois br{lo, g_lo, hi, g_hi};
+      double g = g_lo;
+      for (int k = 0; k < 12 && std::abs(g) > touch_tol_; ++k) {
+        b = br.next();
+        g = solve(b);
+        br.update(b, g, /*lo_side=*/g < 0.0);
+      }
+      if (g < -touch_tol_) {  // not converged: the bracket's end above the floor
+        b = br.hi;
+        solve(b);
+      }
+    }
   }
   // No step may gain mechanical energy (the rest rules rely on it, rest.hpp): the step's end
   // energy (the free motion keeps the kinetic energy; the COM rises by v_z d) against its start's,
