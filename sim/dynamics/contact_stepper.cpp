@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "sim/body/rim.hpp"
 #include "sim/dynamics/contact.hpp"
 #include "sim/dynamics/friction_impact.hpp"
 #include "sim/dynamics/rest.hpp"
@@ -53,7 +54,7 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
   // out of the contact set is above the tolerance here too).
   if (m_->curved()) {  // a cylinder's rim points need the whole orientation
     const Mat3 R = t == 0.0 ? rot_start_ : rot.orientation(t);
-    return p.z() + v.z() * t + rim_lowest_excluding(*m_, R, c);
+    return p.z() + v.z() * t + (rims_new_ ? rim_lowest(*m_, R) : rim_lowest_excluding(*m_, R, c));
   }
   return lowest_flat(c, p, v, t == 0.0 ? Vec3(rot_start_.row(2).transpose()) : rot.bottom_row(t), t);
 }
@@ -99,7 +100,18 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   // curved die's support solve builds its own (rim_support: the rotation is part of its search).
   std::optional<TorqueFreeRotation>& slot = full ? full_rot_ : trial_rot_;
   const bool built = m.curved() && c.n > 0;
-  if (built) rim_support(s, c, d, mechanical_energy(m, s0), a, slot);
+  if (built) {
+    rim_support(s, c, d, mechanical_energy(m, s0), a, slot);
+    if (full && !slap_located_ && !(a.sup.normal_impulse > 0.0)) {
+      // Leaving (no push) and first rising, yet below the floor at the step's end: the sinking is
+      // another part of the rim arriving (rims_new_).
+      const double eps = 1e-3 * d;
+      const double z0 = s.position.z() + rim_lowest(m, s.R);
+      const double z1 = s.position.z() + s.velocity.z() * eps + rim_lowest(m, slot->orientation(eps));
+      const double zd = s.position.z() + s.velocity.z() * d + rim_lowest(m, slot->orientation(d));
+      rims_new_ = z1 > z0 && zd < -touch_tol_;
+    }
+  }
   if (!m.curved() && c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
 
   // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact). A trial of
@@ -340,6 +352,7 @@ int FixedStepper::step(RigidState& s) {
     impact_ = un < -(v_impact_ + v_spin_ * s0.omega.squaredNorm());
     if (impact_) imp_ = apply_friction_impact(m, s0, c, /*restitution=*/true, nullptr, nullptr, &geo_);
   }
+  rims_new_ = false;
   try_step(s0, c, h_, a_, /*full=*/true);
   const Attempt* done = &a_;
   double dt = h_;
@@ -355,7 +368,7 @@ int FixedStepper::step(RigidState& s) {
     const Vec3 z_row = s0.R.row(2).transpose();
     double g_lo = std::numeric_limits<double>::infinity();
     if (m.curved()) {
-      g_lo = s0.position.z() + rim_lowest_excluding(m, s0.R, c);
+      g_lo = s0.position.z() + (rims_new_ ? rim_lowest(m, s0.R) : rim_lowest_excluding(m, s0.R, c));
     } else {
       int j = 0;
       for (int i = 0; i < static_cast<int>(m.vertices.size()); ++i) {
@@ -462,6 +475,7 @@ int FixedStepper::step(RigidState& s) {
     warm_.P[i] = a.next.P[i];
   }
   dt_ = dt;
+  slap_located_ = rims_new_ && dt < h_;
   max_energy_gain = std::max(max_energy_gain, relative_gain(E0, mechanical_energy(m, s)));
   if (m.curved()) {
     // The rims end every step within the touch tolerance of the floor or above it; where the step
