@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "sim/body/rim.hpp"
 #include "sim/dynamics/contact.hpp"
 #include "sim/dynamics/friction_impact.hpp"
 #include "sim/dynamics/rest.hpp"
@@ -53,7 +54,7 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
   // out of the contact set is above the tolerance here too).
   if (m_->curved()) {  // a cylinder's rim points need the whole orientation
     const Mat3 R = t == 0.0 ? rot_start_ : rot.orientation(t);
-    return p.z() + v.z() * t + rim_lowest_excluding(*m_, R, c);
+    return p.z() + v.z() * t + (rims_new_ ? rim_lowest(*m_, R) : rim_lowest_excluding(*m_, R, c));
   }
   return lowest_flat(c, p, v, t == 0.0 ? Vec3(rot_start_.row(2).transpose()) : rot.bottom_row(t), t);
 }
@@ -99,7 +100,18 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   // curved die's support solve builds its own (rim_support: the rotation is part of its search).
   std::optional<TorqueFreeRotation>& slot = full ? full_rot_ : trial_rot_;
   const bool built = m.curved() && c.n > 0;
-  if (built) rim_support(s, c, d, mechanical_energy(m, s0), a, slot);
+  if (built) {
+    rim_support(s, c, d, mechanical_energy(m, s0), a, slot);
+    if (full && !slap_located_ && !(a.sup.normal_impulse > 0.0)) {
+      // Leaving (no push) and first rising, yet below the floor at the step's end: the sinking is
+      // another part of the rim arriving (rims_new_).
+      const double eps = 1e-3 * d;
+      const double z0 = s.position.z() + rim_lowest(m, s.R);
+      const double z1 = s.position.z() + s.velocity.z() * eps + rim_lowest(m, slot->orientation(eps));
+      const double zd = s.position.z() + s.velocity.z() * d + rim_lowest(m, slot->orientation(d));
+      rims_new_ = z1 > z0 && zd < -touch_tol_;
+    }
+  }
   if (!m.curved() && c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
 
   // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact). A trial of
@@ -161,7 +173,9 @@ void FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, dou
   // velocities and friction are unchanged by the shift), b the root of the exact gap at the
   // step's end (the step's own free motion) in b, bracketed, by Illinois: the gap grows with b at
   // rate d to first order (the shift raises every point by b d; only the solve's change of the
-  // spin acts on the sinking). The constraint's centripetal part, as an impulse. b = 0 (the plain
+  // spin acts on the sinking). The constraint's centripetal part, as an impulse. The same from
+  // above when the plain solve leaves the rims above the floor at the step's end (b < 0: less
+  // push, down to none). b = 0 (the plain
   // solve) whenever the rims end the step on the floor without it, and whenever the plain solve
   // does not push (the touching material point leaves the floor): then the sinking is another
   // part of the rim coming down (a coin slapping flat), and asking the leaving point for more
@@ -186,28 +200,59 @@ void FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, dou
       if (rim_in[r]) gap = std::min(gap, s.position.z() + s.velocity.z() * d + rim_low_z(m, z_row, r));
     return gap;
   };
-  double lo = 0.0, g_lo = solve(0.0);
-  if (!(d > 0.0) || g_lo >= -touch_tol_ || !(a.sup.normal_impulse > 0.0)) {
+  const double g0 = solve(0.0);
+  if (!(d > 0.0) || std::abs(g0) <= touch_tol_ || !(a.sup.normal_impulse > 0.0)) {
     a.sup.iterations = sweeps;
     return;
   }
-  // Bracket: from the first-order guess, doubling (every point rises by at least ~b d for large b).
-  double hi = -g_lo / d, g_hi = solve(hi);
-  for (int k = 0; k < 8 && g_hi < -touch_tol_; ++k) {
-    lo = hi, g_lo = g_hi;
-    hi *= 2.0;
-    g_hi = solve(hi);
-  }
-  Illinois br{lo, g_lo, hi, g_hi};
-  double b = hi, g = g_hi;
-  for (int k = 0; k < 12 && std::abs(g) > touch_tol_ && br.f_hi > 0.0; ++k) {
-    b = br.next();
-    g = solve(b);
-    br.update(b, g, /*lo_side=*/g < 0.0);
-  }
-  if (std::abs(g) > touch_tol_ && b != br.hi) {  // not converged: the bracket's end above the floor
-    b = br.hi;
-    solve(b);
+  double b = 0.0;
+  if (g0 < 0.0) {
+    // Sinking. Bracket: from the first-order guess, doubling (every point rises by at least ~b d
+    // for large b).
+    double lo = 0.0, g_lo = g0, hi = -g0 / d, g_hi = solve(hi);
+    for (int k = 0; k < 8 && g_hi < -touch_tol_; ++k) {
+      lo = hi, g_lo = g_hi;
+      hi *= 2.0;
+      g_hi = solve(hi);
+    }
+    Illinois br{lo, g_lo, hi, g_hi};
+    b = hi;
+    double g = g_hi;
+    for (int k = 0; k < 12 && std::abs(g) > touch_tol_ && br.f_hi > 0.0; ++k) {
+      b = br.next();
+      g = solve(b);
+      br.update(b, g, /*lo_side=*/g < 0.0);
+    }
+    if (std::abs(g) > touch_tol_ && b != br.hi) {  // not converged: the bracket's end above the floor
+      b = br.hi;
+      solve(b);
+    }
+  } else {
+    // Rising: the plain solve pushed harder than the rim needs to stay on the floor (the contact
+    // point's centripetal acceleration, -w x (w x r), points up toward the COM, and over the step it
+    // lifts the point by about w^2 r h^2 / 2; the rolling coin hopped off the floor every other
+    // step). The same constraint from above: v_n >= b with b < 0, the push reduced until the
+    // rims end the step on the floor, or no push at all (then the die really leaves the floor).
+    double hi = 0.0, g_hi = g0, lo = -g0 / d, g_lo = solve(lo);
+    for (int k = 0; k < 8 && g_lo > touch_tol_ && a.sup.normal_impulse > 0.0; ++k) {
+      hi = lo, g_hi = g_lo;
+      lo *= 2.0;
+      g_lo = solve(lo);
+    }
+    b = lo;
+    if (g_lo < -touch_tol_) {
+      Illinois br{lo, g_lo, hi, g_hi};
+      double g = g_lo;
+      for (int k = 0; k < 12 && std::abs(g) > touch_tol_; ++k) {
+        b = br.next();
+        g = solve(b);
+        br.update(b, g, /*lo_side=*/g < 0.0);
+      }
+      if (g < -touch_tol_) {  // not converged: the bracket's end above the floor
+        b = br.hi;
+        solve(b);
+      }
+    }
   }
   // No step may gain mechanical energy (the rest rules rely on it, rest.hpp): the step's end
   // energy (the free motion keeps the kinetic energy; the COM rises by v_z d) against its start's,
@@ -307,6 +352,7 @@ int FixedStepper::step(RigidState& s) {
     impact_ = un < -(v_impact_ + v_spin_ * s0.omega.squaredNorm());
     if (impact_) imp_ = apply_friction_impact(m, s0, c, /*restitution=*/true, nullptr, nullptr, &geo_);
   }
+  rims_new_ = false;
   try_step(s0, c, h_, a_, /*full=*/true);
   const Attempt* done = &a_;
   double dt = h_;
@@ -322,7 +368,7 @@ int FixedStepper::step(RigidState& s) {
     const Vec3 z_row = s0.R.row(2).transpose();
     double g_lo = std::numeric_limits<double>::infinity();
     if (m.curved()) {
-      g_lo = s0.position.z() + rim_lowest_excluding(m, s0.R, c);
+      g_lo = s0.position.z() + (rims_new_ ? rim_lowest(m, s0.R) : rim_lowest_excluding(m, s0.R, c));
     } else {
       int j = 0;
       for (int i = 0; i < static_cast<int>(m.vertices.size()); ++i) {
@@ -429,6 +475,7 @@ int FixedStepper::step(RigidState& s) {
     warm_.P[i] = a.next.P[i];
   }
   dt_ = dt;
+  slap_located_ = rims_new_ && dt < h_;
   max_energy_gain = std::max(max_energy_gain, relative_gain(E0, mechanical_energy(m, s)));
   if (m.curved()) {
     // The rims end every step within the touch tolerance of the floor or above it; where the step

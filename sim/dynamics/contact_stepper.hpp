@@ -123,6 +123,14 @@ class FixedStepper {
   std::optional<TorqueFreeRotation> full_rot_;   // the full step's free motion (model_G)
   std::optional<TorqueFreeRotation> trial_rot_;  // a shortened trial's
   Vec3 full_p_ = Vec3::Zero(), full_v_ = Vec3::Zero();
+  // A curved die whose touching rims the support solve does not push (their material points leave
+  // the floor) while the rims' lowest points end the full step below it: another part of the rim
+  // is coming down (a near-flat coin whose lowest point runs along the rim, a slap). The rims'
+  // lowest points then count as new contacts (lowest_new), so the step is shortened to the
+  // instant that part touches, and the next step strikes it. Not twice running (slap_located_):
+  // a rim whose lowest point sinks from the start would be located again at once.
+  bool rims_new_ = false;
+  bool slap_located_ = false;  // the last step was shortened to such an arrival
   bool impact_ = false;   // the current step starts with an impact (solved once for all its trials)
   ImpactResult imp_;      // that impact's result
 };
