@@ -30,6 +30,11 @@
 // All three merged (one-plane lever arms, closed-form flights, fixed sincos): `impulse` bounces
 // 44318 / 43863 / 44986 / 42478, `stepped` 2023 / 2145 / 1989 / 2086; faces as before the sincos
 // change in both (its one-toss swaps in `stepped` went back with the other two changes' rounding).
+// The direct multi-point plastic solves (every point of an edge or triangle sliding or lifting,
+// or every point sticking, solved directly instead of by Gauss-Seidel sweeps; the same Coulomb
+// solution, which the sweeps reach only to their 1e-11 tolerance: sim/dynamics/friction_impact.cpp)
+// left `impulse` unchanged and moved `stepped`'s bounces on Die 1 (2023 -> 2022) and Die 2
+// (2145 -> 2152); no face.
 #include <gtest/gtest.h>
 
 #include "fidelity_test_util.hpp"
@@ -53,8 +58,8 @@ TEST(ImpulseRegression, CountsArePinned) {
 
 TEST(SteppedRegression, CountsArePinned) {
   const Golden golden[] = {
-      {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2023, {0, 0, 0, 0}},
-      {"scenes/paper/die2.toml", {15, 15, 21, 16, 16, 17}, 2145, {0, 0, 0, 0}},
+      {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2022, {0, 0, 0, 0}},
+      {"scenes/paper/die2.toml", {15, 15, 21, 16, 16, 17}, 2152, {0, 0, 0, 0}},
       {"scenes/paper/die3.toml", {14, 19, 14, 22, 21, 10}, 1989, {0, 0, 0, 0}},
       {"scenes/fair.toml", {14, 16, 14, 15, 25, 16}, 2086, {0, 0, 0, 0}},
   };
