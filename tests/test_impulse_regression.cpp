@@ -38,7 +38,10 @@
 // the model (slope from TorqueFreeRotation::bottom_row's rate) instead of Illinois, to the same
 // 1e-3 of the touch tolerance (other step lengths in the last bits): bounces `impulse` 44318 /
 // 43863 / 44986 / 42478 -> 44327 / 43868 / 44983 / 42455, `stepped` 2022 / 2152 / 1989 / 2086 ->
-// 2021 / 2149 / 1982 / 2085; no face in either.
+// 2021 / 2149 / 1982 / 2085; no face in either. Then the direct sliding solve's fixed point
+// accelerated (Anderson, depth 1; the same acceptance test, so more solves converge within its
+// iteration cap instead of going to Gauss-Seidel): `impulse` unchanged, `stepped` bounces Die 1
+// 2021 -> 2023, Die 2 2149 -> 2143; no face.
 #include <gtest/gtest.h>
 
 #include "fidelity_test_util.hpp"
@@ -62,8 +65,8 @@ TEST(ImpulseRegression, CountsArePinned) {
 
 TEST(SteppedRegression, CountsArePinned) {
   const Golden golden[] = {
-      {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2021, {0, 0, 0, 0}},
-      {"scenes/paper/die2.toml", {15, 15, 21, 16, 16, 17}, 2149, {0, 0, 0, 0}},
+      {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2023, {0, 0, 0, 0}},
+      {"scenes/paper/die2.toml", {15, 15, 21, 16, 16, 17}, 2143, {0, 0, 0, 0}},
       {"scenes/paper/die3.toml", {14, 19, 14, 22, 21, 10}, 1982, {0, 0, 0, 0}},
       {"scenes/fair.toml", {14, 16, 14, 15, 25, 16}, 2085, {0, 0, 0, 0}},
   };
