@@ -637,3 +637,81 @@ TEST(FrictionImpact, FaceCornersAtSlightlyDifferentHeightsConverge) {
       }
     }
 }
+
+// The direct solves of a multi-point plastic contact (friction_impact.cpp: solve_sliding, every
+// point of an edge or a triangle sliding or lifting; solve_sticking, every point still) against
+// Gauss-Seidel's converged solution of the same problem: edges, three corners of a face and whole
+// faces, on a homogeneous cube and Die 1's two-material slab layout, mu from 0.1 (mostly sliding)
+// to 2 (mostly sticking), fast and slow states. Where a direct solve is accepted, the velocities
+// are Gauss-Seidel's to its tolerance and Coulomb's law holds at every point (in the cone; a
+// loaded sliding point's friction on the cone's edge, opposite its slip; a sticking point still;
+// a lifted point not approaching); where both decline, the result is the sweeps' bit for bit. A
+// direct solve that accepted an impulse outside a cone, or a direction that is not the final
+// slip's, would give another motion than Gauss-Seidel's and fail here.
+TEST(FrictionImpact, DirectSolvesAreGaussSeidelsSolution) {
+  int sliding = 0, sticking = 0, lifted = 0, declined = 0;
+  double worst = 0.0;
+  for (int layout = 0; layout < 2; ++layout)
+    for (double mu : {0.1, 0.3, 0.6, 2.0}) {
+      const DieModel m = layout == 0 ? cube_model(0.5, mu) : slab_model(0.5, mu, 0.5);
+      TossRandom rng(31, static_cast<std::uint64_t>(layout * 1000 + mu * 10));
+      for (int k = 2; k <= 4; ++k)
+        for (int trial = 0; trial < 200; ++trial)
+          for (bool restitution : {false, true}) {
+            Landing l = landing(m, rng, k, trial % 2 ? 1.0 : 5.0);
+            // Slow states too (a die settling), where sticking is the rule.
+            if (trial % 4 >= 2) {
+              l.s.velocity *= 0.05;
+              l.s.omega *= 0.05;
+            }
+            ASSERT_EQ(l.c.n, k);
+            RigidState direct = l.s, sweeps = l.s;
+            ContactImpulses P, Q;
+            const ImpactResult rd = apply_friction_impact(m, direct, l.c, restitution, nullptr, &P);
+            apply_friction_impact(m, sweeps, l.c, restitution, nullptr, &Q, nullptr, /*direct=*/false);
+            EXPECT_FALSE(rd.corrections.any());
+            const double scale = l.s.velocity.norm() + l.s.omega.norm() * m.bounding_radius;
+            const double dv = (direct.velocity - sweeps.velocity).norm() +
+                              (direct.omega - sweeps.omega).norm() * m.bounding_radius;
+            worst = std::max(worst, dv / scale);
+            EXPECT_LE(dv, 1e-8 * scale) << k << " points, mu " << mu << ", restitution " << restitution;
+            if (restitution) continue;
+            if (rd.iterations > 0) {  // both declined: Gauss-Seidel's own result
+              ++declined;
+              EXPECT_EQ(direct.velocity, sweeps.velocity);
+              EXPECT_EQ(direct.omega, sweeps.omega);
+              continue;
+            }
+            bool all_still = true, any_lifted = false;
+            for (int i = 0; i < k; ++i) {
+              const Vec3& p = P.P[i];
+              const double pt = std::hypot(p.x(), p.y());
+              const double mu_i = m.vertex_friction[l.c.vertex[i]];
+              const Vec3 u = corner_velocity(m, direct, l.c.vertex[i]);
+              const double slip = std::hypot(u.x(), u.y());
+              EXPECT_GE(p.z(), 0.0);
+              EXPECT_LE(pt, mu_i * p.z() * (1.0 + 1e-12));
+              EXPECT_GE(u.z(), -1e-12 * scale);
+              if (p.z() == 0.0) {
+                any_lifted = true;
+                continue;
+              }
+              EXPECT_LE(std::abs(u.z()), 1e-12 * scale);  // loaded: stays on the floor
+              if (slip > 1e-9 * scale) {                    // slides: on the cone's edge, opposite the slip
+                all_still = false;
+                EXPECT_NEAR(pt, mu_i * p.z(), 1e-12 * mu_i * p.z());
+                EXPECT_LT((p.x() * u.x() + p.y() * u.y()) / (pt * slip), -1.0 + 1e-12);
+              }
+            }
+            (any_lifted ? lifted : all_still ? sticking : sliding) += 1;
+          }
+    }
+  // Every branch exercised.
+  EXPECT_GT(sliding, 300);
+  EXPECT_GT(sticking, 100);
+  EXPECT_GT(lifted, 50);
+  EXPECT_GT(declined, 300);
+  std::printf("direct solves: %d sliding, %d sticking, %d with a point lifted; %d declined; worst velocity "
+              "difference from Gauss-Seidel %.2g of the speeds\n",
+              sliding, sticking, lifted, declined, worst);
+}

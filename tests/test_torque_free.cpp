@@ -225,6 +225,33 @@ TEST(TorqueFreeRotation, StateMatchesOrientation) {
   }
 }
 
+// The bottom row with its rate (the stepper's Newton search on corner heights): the row is
+// bottom_row(t)'s, and the rate is d/dt of the row, R^T (e_z x omega) from state(), and matches a
+// central difference of bottom_row.
+TEST(TorqueFreeRotation, BottomRowRateIsItsDerivative) {
+  for (const Case& c : flight_cases(50.0)) {
+    SCOPED_TRACE(c.name);
+    const TorqueFreeRotation rot = c.make();
+    for (double t : {0.0, 0.0004, 0.013, 0.7}) {
+      Vec3 rate;
+      const Vec3 row = rot.bottom_row(t, rate);
+      EXPECT_LE((row - rot.bottom_row(t)).norm(), 1e-15);
+      Mat3 R;
+      Vec3 w;
+      rot.state(t, R, w);
+      const Vec3 expect = R.transpose() * Vec3(-w.y(), w.x(), 0.0);
+      EXPECT_LE((rate - expect).norm(), 1e-12 * 50.0) << "t = " << t;
+      const double dt = 1e-6;
+      const Vec3 fd = (rot.bottom_row(t + dt) - rot.bottom_row(std::max(0.0, t - dt))) / (t > 0.0 ? 2 * dt : dt);
+      EXPECT_LE((rate - fd).norm(), 1e-4 * 50.0) << "t = " << t;
+    }
+  }
+  // A body at rest: no rate.
+  Vec3 rate(1.0, 1.0, 1.0);
+  TorqueFreeRotation(Vec3(1, 2, 3) * 1e-5, generic_R0(), Vec3::Zero()).bottom_row(0.1, rate);
+  EXPECT_EQ(rate, Vec3::Zero());
+}
+
 // PHYSICS.md: energy and |L| drift <= 1e-10 over a 2 s flight at 50 rad/s. The world vector L is
 // checked, which is stronger than its norm.
 void expect_invariants(const Case& c, double duration, int samples, double tolerance) {

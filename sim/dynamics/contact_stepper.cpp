@@ -87,6 +87,25 @@ double FixedStepper::lowest_flat(const ContactSet& c, const Vec3& p, const Vec3&
   return p.z() + v.z() * t + low - m_->rounding;  // a rounded corner touches with its ball
 }
 
+double FixedStepper::lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row,
+                                 const Vec3& z_rate, double t, double& slope) const {
+  const auto& verts = m_->vertices;
+  const int nv = static_cast<int>(verts.size());
+  double low = std::numeric_limits<double>::infinity();
+  int arg = -1;
+  int j = 0;  // c.vertex is ascending
+  for (int i = 0; i < nv; ++i) {
+    if (j < c.n && c.vertex[j] == i) {
+      ++j;
+      continue;
+    }
+    const double z = z_row.dot(verts[i]);
+    if (z < low) low = z, arg = i;
+  }
+  slope = v.z() + (arg >= 0 ? z_rate.dot(verts[arg]) : 0.0);
+  return p.z() + v.z() * t + low - m_->rounding;
+}
+
 void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full) {
   const DieModel& m = *m_;
   // The impact (solved once per step in step(): it does not depend on d) is already in s0.
@@ -275,6 +294,45 @@ void FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, dou
 
 double FixedStepper::model_root(const ContactSet& c, double miss, double lo, double hi, double f_lo, double f_hi,
                                 double& g_model) const {
+  if (!m_->curved()) {
+    // Newton on the corrected model f(t) = lowest(t) + g (h - t) t + miss t (h - t), its slope
+    // the lowest corner's height rate (exact: the free motion's own derivative) plus
+    // (g + miss)(h - 2t); from the bracket's secant point, every iterate kept in the bracket (a
+    // Newton step that leaves it, or a kink where the lowest corner changes, bisects). The last
+    // step is taken without evaluating where it lands when its own error bound, |f''| delta^2 / 2
+    // with |f''| <= (w_max^2 + alpha_max) r + 2 |g + miss|, is already below the tolerance (the
+    // model's value there from the slope). The same tolerance as Illinois's, 1e-3 of the touch
+    // tolerance; fewer evaluations.
+    const TorqueFreeRotation& rot = *full_rot_;
+    const double curvature =
+        (rot.max_omega() * rot.max_omega() + rot.max_alpha()) * m_->bounding_radius + 2.0 * std::abs(m_->gravity + miss);
+    const double tol = 1e-3 * touch_tol_;
+    double x = hi - f_hi * (hi - lo) / (f_hi - f_lo);
+    if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+    for (int it = 0; it < 100; ++it) {
+      Vec3 z_rate;
+      const Vec3 z_row = rot.bottom_row(x, z_rate);
+      double slope = 0.0;
+      g_model = lowest_flat(c, full_p_, full_v_, z_row, z_rate, x, slope) + m_->gravity * (h_ - x) * x;
+      const double f = corrected(g_model, miss, x);
+      if (std::abs(f) <= tol) break;
+      (f > 0.0 ? lo : hi) = x;
+      if (!(hi - lo > 1e-15 * h_)) break;
+      const double dg = slope + m_->gravity * (h_ - 2.0 * x);  // the model's own slope
+      const double delta = -f / (dg + miss * (h_ - 2.0 * x));
+      const double next = x + delta;
+      if (!(next > lo && next < hi)) {
+        x = 0.5 * (lo + hi);
+        continue;
+      }
+      if (0.5 * curvature * delta * delta <= tol) {
+        g_model += delta * dg;
+        return next;
+      }
+      x = next;
+    }
+    return x;
+  }
   Illinois br{lo, f_lo, hi, f_hi};
   double mid = hi;
   for (int it = 0; it < 100 && br.hi - br.lo > 1e-15 * h_; ++it) {

@@ -99,13 +99,18 @@ class FixedStepper {
   // t = 0, the step's start, and at t = h, the full step itself).
   double corrected(double model_g, double miss, double t) const { return model_g + miss * t * (h_ - t); }
   // The root of the corrected model in [lo, hi], given its values f_lo > 0 at lo and f_hi <= 0 at
-  // hi, Illinois. g_model: in, model_G(hi); out, model_G at the returned point.
+  // hi: a flat die's by Newton on the model (its slope from the rotation's rate), safeguarded by
+  // the bracket; a curved die's by Illinois. g_model: in, model_G(hi); out, model_G at the
+  // returned point.
   double model_root(const ContactSet& c, double miss, double lo, double hi, double f_lo, double f_hi,
                     double& g_model) const;
   // The lowest height over corners not in c, at time t of the free motion after the step's solve.
   double lowest_new(const ContactSet& c, const Vec3& p, const Vec3& v, const TorqueFreeRotation& rot, double t) const;
   // The same for a flat-faced die, given the orientation's bottom row at t.
   double lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row, double t) const;
+  // lowest_flat with its slope in t (the lowest corner's height rate; z_rate: the row's rate).
+  double lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row, const Vec3& z_rate,
+                     double t, double& slope) const;
   const DieModel* m_;
   // The vertices by coordinate, for lowest_flat's vectorised pass (flat dice of up to
   // kSoaVertices corners; soa_vertices_ = 0: the plain loop).

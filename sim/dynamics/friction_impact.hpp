@@ -6,7 +6,10 @@
 //     P_n u_n = 0, |P_t| <= mu P_n, sticking if the impulse fits the cone, else sliding with the
 //     friction opposite the final slip (maximal dissipation). One point: exact (sticking
 //     P = -W^-1 u, else a bracketed root in the slip direction; W the contact compliance
-//     (1/m) 1 - [r]x I_w^-1 [r]x, u the point's velocity v + w x r). Several: projected
+//     (1/m) 1 - [r]x I_w^-1 [r]x, u the point's velocity v + w x r). Several, on a polyhedral die:
+//     first directly, if every point of an edge or a triangle slides (or lifts), or if every point
+//     sticks (friction_impact.cpp: solve_sliding, solve_sticking; accepted only where Coulomb's
+//     law verifies); else projected
 //     Gauss-Seidel where every update is the exact minimiser of the kinetic energy over its own
 //     block (normal: P_n >= 0; tangential: the disc |P_t| <= mu P_n, in the metric of W_tt), so
 //     every sweep lowers the energy; warm-started, symmetric sweeps, converged to 1e-11 of the
@@ -104,10 +107,12 @@ ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol);
 // Coulomb friction. Updates s.velocity and s.omega; positions are untouched. `warm`: impulses of
 // a previous solve (matched by vertex) to start the compression from; `out`: the impulse at every
 // point (compression plus restitution); `geometry`: the set-up shared with other solves of c at
-// s.R (see ContactGeometry). All optional.
+// s.R (see ContactGeometry). All optional. `direct`: a polyhedral die's multi-point plastic solve
+// first tries the direct solves (every point sliding or lifting, then every point sticking;
+// friction_impact.cpp); false: always the Gauss-Seidel sweeps (the tests compare the two).
 ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,
                                    const ContactImpulses* warm = nullptr, ContactImpulses* out = nullptr,
-                                   ContactGeometry* geometry = nullptr);
+                                   ContactGeometry* geometry = nullptr, bool direct = true);
 
 // Velocity of corner `vertex`'s contact point (world).
 inline Vec3 corner_velocity(const DieModel& m, const RigidState& s, int vertex) {

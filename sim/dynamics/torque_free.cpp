@@ -424,6 +424,37 @@ Vec3 TorqueFreeRotation::bottom_row(double t) const {
   return r;
 }
 
+Vec3 TorqueFreeRotation::bottom_row(double t, Vec3& rate) const {
+  if (kind_ == Kind::Still) {
+    rate.setZero();
+    return R0_.row(2).transpose();
+  }
+  if (kind_ == Kind::General && !gen_.steady) {
+    Mat3 R;
+    Vec3 w;
+    state(t, R, w);
+    rate = R.transpose() * Vec3(-w.y(), w.x(), 0.0);
+    return R.row(2).transpose();
+  }
+  // bottom_row's formulas differentiated: the precession angle a = precession_rate t turns the
+  // row, then the spin b = spin_rate t turns its p, q components.
+  const Symmetric& s = sym_;
+  SinCos a, b;
+  sincos2(s.precession_rate * t, s.spin_rate * t, a, b);
+  Vec3 r = s.along.row(2).transpose() + a.cos * s.across.row(2).transpose() + a.sin * s.cross.row(2).transpose();
+  Vec3 dr = s.precession_rate * (a.cos * s.cross.row(2).transpose() - a.sin * s.across.row(2).transpose());
+  if (s.spin_rate != 0.0) {
+    const double cb = b.cos, sb = b.sin;
+    const double rp = r(s.p), rq = r(s.q), dp = dr(s.p), dq = dr(s.q);
+    r(s.p) = cb * rp + sb * rq;
+    r(s.q) = cb * rq - sb * rp;
+    dr(s.p) = cb * dp + sb * dq + s.spin_rate * r(s.q);
+    dr(s.q) = cb * dq - sb * dp - s.spin_rate * r(s.p);
+  }
+  rate = dr;
+  return r;
+}
+
 Mat3 TorqueFreeRotation::orientation(double t) const {
   switch (kind_) {
     case Kind::Still:

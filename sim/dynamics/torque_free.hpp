@@ -22,6 +22,8 @@ class TorqueFreeRotation {
   // The orientation's bottom row (world z of each body axis) at time t: all a corner's height needs.
   // Equal to orientation(t).row(2) up to rounding.
   Vec3 bottom_row(double t) const;
+  // The same and its time derivative, R(t)^T (e_z x omega(t)) (the model search's Newton slope).
+  Vec3 bottom_row(double t, Vec3& rate) const;
   // Orientation and world angular velocity at time t.
   void state(double t, Mat3& R, Vec3& omega_world) const;
 
