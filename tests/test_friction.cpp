@@ -50,6 +50,28 @@ RigidState replay_state(const double (&R)[9], const double (&x)[3], const double
   return s;
 }
 
+// One impact from a captured state: converged, nothing repaired, no energy gained, every point
+// inside its friction cone with a non-negative normal impulse and no longer approaching.
+void expect_clean_impact(const DieModel& m, RigidState s, const ContactSet& c, bool restitution,
+                         const std::string& what) {
+  const double scale = s.velocity.norm() + s.omega.norm() * m.bounding_radius;
+  const double e0 = kinetic_energy(m, s);
+  ContactImpulses P;
+  const ImpactResult r = apply_friction_impact(m, s, c, restitution, nullptr, &P);
+  EXPECT_EQ(r.corrections.pgs_unconverged, 0u) << what;
+  EXPECT_EQ(r.corrections.fallbacks, 0u) << what;
+  EXPECT_EQ(r.corrections.energy_clamps, 0u) << what;
+  EXPECT_LE(kinetic_energy(m, s), e0) << what;
+  ASSERT_EQ(P.n, c.n) << what;
+  for (int i = 0; i < c.n; ++i) {
+    const Vec3& p = P.P[i];
+    const double mu = m.vertex_friction[c.vertex[i]];
+    EXPECT_GE(p.z(), 0.0) << what;
+    EXPECT_LE(std::hypot(p.x(), p.y()), mu * p.z() * (1.0 + 1e-9) + 1e-15) << what;
+    EXPECT_GE(corner_velocity(m, s, c.vertex[i]).z(), -1e-9 * scale) << what;
+  }
+}
+
 }  // namespace
 
 TEST(FrictionImpact, NeverCreatesEnergy) {
@@ -451,29 +473,13 @@ TEST(FrictionImpact, EdgeRestitutionFrictionStallsAreSolvedExactly) {
   };
   for (const Stalled& st : cases) {
     const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/" + st.scene));
-    RigidState s = replay_state(st.R, st.x, st.v, st.w);
+    const RigidState s = replay_state(st.R, st.x, st.v, st.w);
     ContactSet c;
     c.n = 2;
     c.vertex[0] = st.v0;
     c.vertex[1] = st.v1;
-    const double scale = s.velocity.norm() + s.omega.norm() * m.bounding_radius;
-    const double e0 = kinetic_energy(m, s);
-    ContactImpulses P;
-    const ImpactResult r = apply_friction_impact(m, s, c, true, nullptr, &P);
-    EXPECT_EQ(r.corrections.pgs_unconverged, 0u) << st.scene << " vertices " << st.v0 << ", " << st.v1;
-    EXPECT_EQ(r.corrections.fallbacks, 0u);
-    EXPECT_EQ(r.corrections.energy_clamps, 0u);
-    EXPECT_LE(kinetic_energy(m, s), e0);
-    ASSERT_EQ(P.n, 2);
-    for (int i = 0; i < 2; ++i) {
-      const Vec3& p = P.P[i];
-      const double mu = m.vertex_friction[c.vertex[i]];
-      const double pt = std::hypot(p.x(), p.y());
-      EXPECT_GE(p.z(), 0.0);
-      EXPECT_LE(pt, mu * p.z() * (1.0 + 1e-9) + 1e-15);
-      const Vec3 u = corner_velocity(m, s, c.vertex[i]);
-      EXPECT_GE(u.z(), -1e-9 * scale);
-    }
+    expect_clean_impact(m, s, c, true, std::string(st.scene) + " vertices " + std::to_string(st.v0) + ", " +
+                                           std::to_string(st.v1));
   }
 }
 
@@ -507,26 +513,11 @@ TEST(FrictionImpact, FaceRestitutionWithAnUnloadedCornerConverges) {
   };
   for (const Face& f : cases) {
     const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/" + f.scene));
-    RigidState s = replay_state(f.R, f.x, f.v_, f.w);
+    const RigidState s = replay_state(f.R, f.x, f.v_, f.w);
     ContactSet c;
     c.n = 3;
     for (int i = 0; i < 3; ++i) c.vertex[i] = f.v[i];
-    const double scale = s.velocity.norm() + s.omega.norm() * m.bounding_radius;
-    const double e0 = kinetic_energy(m, s);
-    ContactImpulses P;
-    const ImpactResult r = apply_friction_impact(m, s, c, true, nullptr, &P);
-    EXPECT_EQ(r.corrections.pgs_unconverged, 0u) << f.scene;
-    EXPECT_EQ(r.corrections.fallbacks, 0u) << f.scene;
-    EXPECT_EQ(r.corrections.energy_clamps, 0u) << f.scene;
-    EXPECT_LE(kinetic_energy(m, s), e0) << f.scene;
-    ASSERT_EQ(P.n, 3);
-    for (int i = 0; i < 3; ++i) {
-      const Vec3& p = P.P[i];
-      const double mu = m.vertex_friction[c.vertex[i]];
-      EXPECT_GE(p.z(), 0.0) << f.scene;
-      EXPECT_LE(std::hypot(p.x(), p.y()), mu * p.z() * (1.0 + 1e-9) + 1e-15) << f.scene;
-      EXPECT_GE(corner_velocity(m, s, c.vertex[i]).z(), -1e-9 * scale) << f.scene;
-    }
+    expect_clean_impact(m, s, c, true, f.scene);
   }
 }
 
@@ -614,27 +605,12 @@ TEST(FrictionImpact, FaceCornersAtSlightlyDifferentHeightsConverge) {
   const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/paper/die3.toml"));
   for (const Face& f : cases)
     for (const bool restitution : {true, false}) {
-      RigidState s = replay_state(f.R, f.x, f.v_, f.w);
+      const RigidState s = replay_state(f.R, f.x, f.v_, f.w);
       ContactSet c;
       c.n = f.n;
       for (int i = 0; i < f.n; ++i) c.vertex[i] = f.v[i];
-      const double scale = s.velocity.norm() + s.omega.norm() * m.bounding_radius;
-      const double e0 = kinetic_energy(m, s);
-      ContactImpulses P;
-      const ImpactResult r = apply_friction_impact(m, s, c, restitution, nullptr, &P);
       const std::string what = std::to_string(f.n) + " corners, restitution " + (restitution ? "on" : "off");
-      EXPECT_EQ(r.corrections.pgs_unconverged, 0u) << what;
-      EXPECT_EQ(r.corrections.fallbacks, 0u) << what;
-      EXPECT_EQ(r.corrections.energy_clamps, 0u) << what;
-      EXPECT_LE(kinetic_energy(m, s), e0) << what;
-      ASSERT_EQ(P.n, f.n);
-      for (int i = 0; i < f.n; ++i) {
-        const Vec3& p = P.P[i];
-        const double mu = m.vertex_friction[c.vertex[i]];
-        EXPECT_GE(p.z(), 0.0) << what;
-        EXPECT_LE(std::hypot(p.x(), p.y()), mu * p.z() * (1.0 + 1e-9) + 1e-15) << what;
-        EXPECT_GE(corner_velocity(m, s, c.vertex[i]).z(), -1e-9 * scale) << what;
-      }
+      expect_clean_impact(m, s, c, restitution, what);
     }
 }
 
