@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "temp_files.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,12 +22,6 @@ struct CliRun {
   std::string out, err;
 };
 
-// CTest runs tests as parallel processes: every file a test writes carries its name and pid.
-inline std::string unique_temp(const std::string& name) {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  return ::testing::TempDir() + "dicesim_" + info->test_suite_name() + "_" + info->name() + "_" +
-         std::to_string(::getpid()) + "_" + name;
-}
 
 // `args` go through the shell, so quoting works as on a command line.
 inline CliRun run_dicesim(const std::string& args) {

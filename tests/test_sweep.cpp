@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "scenes_for_tests.hpp"
+#include "temp_files.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/models/initial_state.hpp"
@@ -21,7 +22,7 @@ const std::string kSrc = DICESIM_SOURCE_DIR;
 const std::string kDie1 = kSrc + "/scenes/paper/die1.toml";
 
 std::string write_temp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + std::to_string(::getpid()) + "_" + name;
+  const std::string path = dicesim::testing::unique_temp(name);
   std::ofstream(path) << text;
   return path;
 }
