@@ -1,4 +1,5 @@
-// Helpers shared by the fidelity-ladder tests (test_fidelity_*, test_friction*, test_rest*, test_extremes*).
+// Helpers shared by the fidelity-ladder tests (test_fidelity_*, test_friction*, test_rest*, test_extremes*,
+// test_cylinder).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -11,7 +12,10 @@
 
 #include "scenes_for_tests.hpp"
 #include "sim/body/die_model.hpp"
+#include "sim/dynamics/contact_stepper.hpp"
+#include "sim/dynamics/rest.hpp"
 #include "sim/models/compile.hpp"
+#include "sim/models/toss.hpp"
 #include "sim/study/monte_carlo.hpp"
 
 namespace dicesim::testing {
@@ -86,6 +90,51 @@ inline void check_pinned(const Golden& g, Fidelity f, std::uint64_t n) {
                 (unsigned long long)c.bounces, (unsigned long long)corr[0], (unsigned long long)corr[1],
                 (unsigned long long)corr[2], (unsigned long long)corr[3]);
   }
+}
+
+// Above every basin's barrier: the energy criterion cannot decide (only lying flat can).
+inline bool above_barriers(const DieModel& m, const RigidState& s) {
+  const Vec3 wb = s.R.transpose() * s.omega;
+  const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
+  return ke + m.mass * m.gravity * s.position.z() >= m.mass * m.gravity * m.max_escape;
+}
+
+// Soundness of a rest rule: for tosses [0, n) at `seed`, from every settled toss's final state the
+// rule names the face the toss read, and `steps` more contact steps of length h never change the
+// face down that down_face(m, R) reads every `every` steps (the energy was below the basin's saddle,
+// or the die lay flat, and stays so). Returns how many tosses settled and how many of those ended
+// above every basin's barrier (only the lying-flat rule can decide those).
+struct RestSoundness {
+  int settled = 0, above_barriers = 0;
+};
+template <class DownFace>
+RestSoundness check_rest_is_sound(const DieModel& m, std::uint64_t seed, int n, double h, int steps, int every,
+                                  DownFace down_face, const std::string& what) {
+  RestSoundness out;
+  for (int i = 0; i < n; ++i) {
+    RigidState s;
+    TossProbe probe;
+    probe.final_state = &s;
+    const TossResult r = toss(m, seed, static_cast<std::uint64_t>(i), &probe);
+    if (r.status != TossStatus::Settled) continue;
+    ++out.settled;
+    const int down = rest_face_down(m, s, 0.5);
+    if (down < 0 || result_face(m, down) != r.face_index) {
+      ADD_FAILURE() << what << " toss " << i << ": the rest rule names face " << down << " for a toss read as "
+                    << r.face_index;
+      return out;
+    }
+    out.above_barriers += above_barriers(m, s);
+    FixedStepper st(m, h);
+    for (int k = 1; k <= steps; ++k) {
+      st.step(s);
+      if (k % every == 0 && down_face(m, s.R) != down) {
+        ADD_FAILURE() << what << " toss " << i << ": face " << down << " left at step " << k;
+        return out;
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace dicesim::testing

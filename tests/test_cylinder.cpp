@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "fidelity_test_util.hpp"
 #include "sim/body/body.hpp"
 #include "sim/body/cylinder.hpp"
 #include "sim/body/rim.hpp"
@@ -411,9 +412,7 @@ TEST(CylinderImpulse, LyingFlatDecidesWhateverTheSlidingSpeed) {
   s.position = Vec3(0.0, 0.0, -rim_lowest(m, s.R));
   s.velocity = Vec3(1.0, 0.0, 0.0);
   s.omega = Vec3(0.0, 0.0, 5.0);
-  const Vec3 wb = s.R.transpose() * s.omega;
-  const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
-  ASSERT_GE(ke + m.mass * m.gravity * s.position.z(), m.mass * m.gravity * m.max_escape);
+  ASSERT_TRUE(dicesim::testing::above_barriers(m, s));
   EXPECT_EQ(rest_face_down(m, s, 0.5), 1);
   FixedStepper st(m, 5e-4);
   for (int k = 1; k <= 1000; ++k) {
@@ -426,26 +425,10 @@ TEST(CylinderImpulse, LyingFlatDecidesWhateverTheSlidingSpeed) {
 TEST(CylinderImpulse, RestIsSound) {
   SoftTable soft;
   const DieModel m = coin_model(0.01, 0.012, std::string(kTable) + "[sim]\nfidelity = \"impulse\"\n");
-  int settled = 0;
-  for (int i = 0; i < 200; ++i) {
-    RigidState s;
-    TossProbe probe;
-    probe.final_state = &s;
-    const TossResult r = toss(m, 31, static_cast<std::uint64_t>(i), &probe);
-    if (r.status != TossStatus::Settled) continue;
-    ++settled;
-    const int down = rest_face_down(m, s, 0.5);
-    ASSERT_GE(down, 0);
-    ASSERT_EQ(result_face(m, down), r.face_index);
-    FixedStepper st(m, 5e-4);
-    for (int k = 1; k <= 600; ++k) {
-      st.step(s);
-      if (k % 100 == 0) {
-        ASSERT_EQ(rim_quasi_static_down(m, s.R, 0.5), down) << "toss " << i << " step " << k;
-      }
-    }
-  }
-  EXPECT_GE(settled, 195);
+  const dicesim::testing::RestSoundness r = dicesim::testing::check_rest_is_sound(
+      m, 31, 200, 5e-4, 600, 100, [](const DieModel& d, const Mat3& R) { return rim_quasi_static_down(d, R, 0.5); },
+      "coin");
+  EXPECT_GE(r.settled, 195);
 }
 
 }  // namespace

@@ -101,13 +101,6 @@ DieModel paper_die(const char* name) {
   return compile(load_scene(std::string(DICESIM_SOURCE_DIR "/scenes/paper/") + name, {"sim.fidelity=\"impulse\""}));
 }
 
-// Above every basin's barrier: the energy criterion cannot decide (only lying flat can).
-bool above_barriers(const DieModel& m, const RigidState& s) {
-  const Vec3 wb = s.R.transpose() * s.omega;
-  const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
-  return ke + m.mass * m.gravity * s.position.z() >= m.mass * m.gravity * m.max_escape;
-}
-
 }  // namespace
 
 // Die 1 lying flat on each face, sliding at 1 m/s and spinning at 10 rad/s: kinetic energy far
@@ -143,26 +136,11 @@ TEST(Rest, LyingFlatDecidesWhateverTheSlidingSpeed) {
 TEST(ImpulseRest, RestIsSoundOnTheDice) {
   for (const char* name : {"die1.toml", "die2.toml", "die3.toml"}) {
     const DieModel m = paper_die(name);
-    int settled = 0, fast = 0;
-    for (int i = 0; i < 400; ++i) {
-      RigidState s;
-      TossProbe probe;
-      probe.final_state = &s;
-      const TossResult r = toss(m, 17, static_cast<std::uint64_t>(i), &probe);
-      if (r.status != TossStatus::Settled) continue;
-      ++settled;
-      const int down = rest_face_down(m, s, 0.5);
-      ASSERT_GE(down, 0);
-      ASSERT_EQ(result_face(m, down), r.face_index);
-      fast += above_barriers(m, s);
-      FixedStepper st(m, m.contact_step);
-      for (int k = 1; k <= 500; ++k) {
-        st.step(s);
-        if (k % 50 == 0) ASSERT_EQ(quasi_static_down_face(m, s.R, 0.5), down) << name << " toss " << i << " step " << k;
-      }
-    }
-    EXPECT_EQ(settled, 400) << name;
-    std::printf("%s: %d of %d settled states above every barrier\n", name, fast, settled);
-    EXPECT_GE(fast, 40) << name << ": the states above every barrier are the ones this test is about";
+    const RestSoundness r = check_rest_is_sound(
+        m, 17, 400, m.contact_step, 500, 50, [](const DieModel& d, const Mat3& R) { return quasi_static_down_face(d, R, 0.5); },
+        name);
+    EXPECT_EQ(r.settled, 400) << name;
+    std::printf("%s: %d of %d settled states above every barrier\n", name, r.above_barriers, r.settled);
+    EXPECT_GE(r.above_barriers, 40) << name << ": the states above every barrier are the ones this test is about";
   }
 }
