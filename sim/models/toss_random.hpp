@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "sim/log.hpp"
 #include "sim/math.hpp"
 #include "sim/sincos.hpp"
 
@@ -27,13 +28,15 @@ class TossRandom {
     return buf_[left_];
   }
 
-  // Standard normal (Box-Muller; the pair's second value is kept for the next call).
+  // Standard normal (Box-Muller; the pair's second value is kept for the next call). The
+  // logarithm and the sine and cosine are this project's own (sim/log.hpp, sim/sincos.hpp): libm's
+  // pick a variant by CPU at run time, and a draw must be the same on every worker's machine.
   double normal() {
     if (has_spare_) {
       has_spare_ = false;
       return spare_;
     }
-    const double r = std::sqrt(-2.0 * std::log(uniform()));
+    const double r = std::sqrt(-2.0 * log_fixed(uniform()));
     const SinCos a = sincos_turns(uniform());  // the angle 2 pi u
     spare_ = r * a.sin;
     has_spare_ = true;
