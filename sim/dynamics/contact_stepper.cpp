@@ -9,6 +9,7 @@
 #include "sim/dynamics/rest.hpp"
 #include "sim/dynamics/rim_rest.hpp"
 #include "sim/illinois.hpp"
+#include "sim/sincos.hpp"
 
 namespace dicesim {
 
@@ -618,8 +619,8 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
                           : (s.R * (m.vertices[c.vertex[1]] - m.vertices[c.vertex[0]])).normalized();
         if (std::fmod(tiebreak * 4096.0, 1.0) < 0.5) axis = -axis;
       } else {
-        const double a = 2.0 * kPi * tiebreak;
-        axis = Vec3(std::cos(a), std::sin(a), 0.0);
+        const SinCos a = sincos_turns(tiebreak);  // the angle 2 pi tiebreak
+        axis = Vec3(a.cos, a.sin, 0.0);
       }
       s.omega += nudge * axis;
       ++out.nudges;

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "sim/dynamics/rim_rest.hpp"
+#include "sim/sincos.hpp"
 
 namespace dicesim {
 namespace {
@@ -24,8 +25,8 @@ int roll_vertex(const DieModel& m, Mat3 R, int p, double tiebreak, int& guard) {
     // 1. Pivot about corner p: the COM falls in the vertical plane through p and itself.
     Vec3 dh(-wp.x(), -wp.y(), 0.0);  // horizontal COM offset from p
     if (dh.norm() <= tiny) {         // COM straight above the corner: the toss decides the way
-      const double a = 2.0 * kPi * tiebreak;
-      dh = Vec3(std::cos(a), std::sin(a), 0.0);
+      const SinCos a = sincos_turns(tiebreak);  // the angle 2 pi tiebreak
+      dh = Vec3(a.cos, a.sin, 0.0);
     }
     const Vec3 axis = Vec3::UnitZ().cross(dh).normalized();
     // The first theta in [0, pi] with A cos + B sin = 0 is atan2(A, -B); on [0, pi] the angle

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "sim/dynamics/contact.hpp"
+#include "sim/sincos.hpp"
 
 namespace dicesim {
 namespace {
@@ -72,8 +73,8 @@ int rim_quasi_static_down(const DieModel& m, const Mat3& R, double tiebreak) {
     Vec3 gt = g - g.dot(d) * d;
     if (gt.norm() <= 1e-12 * rim.radius) {  // balanced exactly: the toss decides the way
       const Vec3 u = d.unitOrthogonal(), v = d.cross(u);
-      const double a = 2.0 * kPi * tiebreak;
-      gt = std::cos(a) * u + std::sin(a) * v;
+      const SinCos a = sincos_turns(tiebreak);  // the angle 2 pi tiebreak
+      gt = a.cos * u + a.sin * v;
     }
     const Vec3 next = (d - kStep * gt.normalized()).normalized();
     if ((next.dot(k) > 0.0) != (dk > 0.0) && valley) return 2;  // reached the side's valley

@@ -39,6 +39,8 @@
 // sincos and a few divisions. The separatrix itself (k' = 0 exactly) uses sn = tanh, cn = dn = sech.
 #include "sim/dynamics/torque_free.hpp"
 
+#include "sim/atan.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
@@ -81,7 +83,7 @@ double carlson_rj_precession(double x, double y, double p) {
       rc = 1.0 + E * (-1.0 / 3 + E * (1.0 / 5 + E * (-1.0 / 7 + E * (1.0 / 9 + E * (-1.0 / 11 + E / 13)))));
     } else {
       const double rE = std::sqrt(E);
-      rc = std::atan(rE) / rE;
+      rc = atan_fixed(rE) / rE;  // not libm's: the same bits on every CPU (sim/atan.hpp)
     }
     rc_sum += scale / D * rc;
     const double lambda = rx * ry + rx * rz + ry * rz;
