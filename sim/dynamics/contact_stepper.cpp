@@ -164,6 +164,7 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   if (full) {
     full_p_ = p;
     full_v_ = v;
+    full_w_ = s.omega;
   }
   s.position = p + d * v;
   s.R = R_end;
@@ -293,6 +294,149 @@ void FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, dou
   a.sup.iterations = sweeps;
 }
 
+namespace {
+
+Mat3 skew_of(const Vec3& r) {
+  Mat3 S;
+  S << 0.0, -r.z(), r.y(), r.z(), 0.0, -r.x(), -r.y(), r.x(), 0.0;
+  return S;
+}
+
+// The derivative in the step length of a plastic support solve's impulses at K points, the solve's
+// regime fixed (FixedStepper::predicted_miss): dP (3K) from one linear system, the rows of point i
+// by its regime at the solved state: no impulse (dP_i = 0), sticking (its velocity stays 0) or
+// sliding (normal velocity 0; P_t = -mu P_n s/|s| linearised). The pre-solve velocities change by
+// -g e_z per unit length. W_ij = I/m - [r_i]x I_w^-1 [r_j]x, the points' compliance blocks. False
+// if the system has no solution to 1e-9 (a sticking edge's or face's impulses are not unique, but
+// then any solution gives the same motion, and the residual accepts it).
+template <int K>
+bool support_derivative(const ContactPoints& pts, const Mat3& Iinv, double mass, double g, const Vec3& v,
+                        const Vec3& w, const ContactImpulses& P, double speed, Vec3& dF, Vec3& dM) {
+  constexpr int N = 3 * K;
+  Eigen::Matrix<double, N, N> A = Eigen::Matrix<double, N, N>::Zero();
+  Eigen::Matrix<double, N, 1> b = Eigen::Matrix<double, N, 1>::Zero();
+  Mat3 S[K], T[K];
+  for (int j = 0; j < K; ++j) {
+    S[j] = skew_of(pts.r[j]);
+    T[j] = Iinv * S[j];
+  }
+  const Mat3 Im = Mat3::Identity() / mass;
+  for (int i = 0; i < K; ++i) {
+    const Vec3& Pi = P.P[i];
+    const Vec3 u = v + w.cross(pts.r[i]);  // the point's velocity after the solve
+    const Eigen::Vector2d slip(u.x(), u.y());
+    const double sn = slip.norm();
+    if (!(Pi.z() > 0.0)) {
+      A.template block<3, 3>(3 * i, 3 * i).setIdentity();
+      continue;
+    }
+    b(3 * i + 2) = g;
+    if (sn <= 1e-9 * speed) {
+      for (int j = 0; j < K; ++j) A.template block<3, 3>(3 * i, 3 * j) = Im - S[i] * T[j];
+      continue;
+    }
+    const Eigen::Vector2d dir = slip / sn;
+    const double cf = pts.mu[i] * Pi.z() / sn;
+    const Eigen::Matrix2d Pr = cf * (Eigen::Matrix2d::Identity() - dir * dir.transpose());
+    for (int j = 0; j < K; ++j) {
+      const Mat3 W = Im - S[i] * T[j];
+      A.template block<1, 3>(3 * i + 2, 3 * j) = W.row(2);
+      A.template block<2, 3>(3 * i, 3 * j) = Pr * W.template topRows<2>();
+    }
+    A(3 * i, 3 * i) += 1.0;
+    A(3 * i + 1, 3 * i + 1) += 1.0;
+    A(3 * i, 3 * i + 2) += pts.mu[i] * dir.x();
+    A(3 * i + 1, 3 * i + 2) += pts.mu[i] * dir.y();
+  }
+  const Eigen::Matrix<double, N, 1> x = A.partialPivLu().solve(b);
+  if (!x.allFinite() || !((A * x - b).norm() <= 1e-9 * b.norm())) return false;
+  dF.setZero();
+  dM.setZero();
+  for (int j = 0; j < K; ++j) {
+    const Vec3 Pj = x.template segment<3>(3 * j);
+    dF += Pj;
+    dM += pts.r[j].cross(Pj);
+  }
+  return true;
+}
+
+}  // namespace
+
+double FixedStepper::predicted_miss(const ContactSet& c, const Vec3& r) {
+  // The model (model_G) moves the full step's free motion by what a shorter gravity kick alone
+  // changes; but with corners in contact the support solve absorbs part of the kick, so the
+  // shortened step's motion after its solve differs from the model's to first order in (h - d):
+  // G(d) - model_G(d) = -d (h - d) [v'_z + g + (w' x r(d/2))_z] + O(d (h - d)^2), v' and w' the
+  // derivatives in the step length of the velocities after the solve, r(d/2) the arriving
+  // corner's lever half-way (its lever at the start turned by the full step's spin, to first
+  // order: the miss's rate in t). v' and w' come from the full step's solve linearised with its
+  // regime fixed (support_derivative). Only a prediction of the first trial's length: every trial
+  // is still a whole step, accepted only within the touch tolerance, and the search goes on from
+  // the misses it measures. 0 (the plain model) when the linearisation has no solution. r: the
+  // arriving corner's lever at the step's start.
+  const DieModel& m = *m_;
+  const int k = c.n;
+  if (m.curved() || k == 0 || k > 4 || a_.next.n != k) return 0.0;
+  const double g = m.gravity;
+  const double speed = full_v_.norm() + full_w_.norm() * m.bounding_radius + 1e-2 * std::sqrt(g * m.bounding_radius);
+  Vec3 dF, dM;
+  bool ok = false;
+  switch (k) {
+    case 1: ok = support_derivative<1>(geo_.pts, geo_.inv_inertia, m.mass, g, full_v_, full_w_, a_.next, speed, dF, dM); break;
+    case 2: ok = support_derivative<2>(geo_.pts, geo_.inv_inertia, m.mass, g, full_v_, full_w_, a_.next, speed, dF, dM); break;
+    case 3: ok = support_derivative<3>(geo_.pts, geo_.inv_inertia, m.mass, g, full_v_, full_w_, a_.next, speed, dF, dM); break;
+    default: ok = support_derivative<4>(geo_.pts, geo_.inv_inertia, m.mass, g, full_v_, full_w_, a_.next, speed, dF, dM); break;
+  }
+  if (!ok) return 0.0;
+  const Vec3 dw = geo_.inv_inertia * dM;
+  const double miss = -(dF.z() / m.mass) - dw.cross(r).z();
+  const double rate = -0.5 * dw.cross(full_w_.cross(r)).z();
+  if (!std::isfinite(miss) || !std::isfinite(rate)) return 0.0;
+  miss_rate_ = rate;
+  return miss;
+}
+
+double FixedStepper::hermite_start(double miss, double lo, double hi, double x) const {
+  // The corrected model with the arriving corner's height about the COM, q(t) = (R(t) r)_z, replaced
+  // by its cubic Hermite interpolant on [0, h] from the full step's own ends (q and its rate
+  // (w x R r)_z at t = 0 and t = h: no evaluation of the rotation); every other term of the
+  // model is a polynomial of degree <= 3 and kept exactly. Interpolation error about h^4 q4 / 384,
+  // q4 the fourth derivative, ~|w|^4 r: ~1e-13 m for a die rocking at 10 rad/s with 1 ms steps,
+  // so the root of this cubic starts model_root's Newton within ~1e-12 s of the model's root (one
+  // evaluation then meets the tolerance). Newton on the cubic, kept in (lo, hi); x, the secant
+  // point, if it leaves.
+  // The cubic in powers of t: base + v t + H(t) + g (h - t) t + (miss + rate t) t (h - t).
+  const double h = h_, g = m_->gravity;
+  const double q0 = hq_[0], p0 = hq_[1], q1 = hq_[2], p1 = hq_[3];
+  const double c0 = full_p_.z() - m_->rounding + q0;
+  const double c1 = full_v_.z() + p0 + g * h + miss * h;
+  const double c2 = (3.0 * (q1 - q0) / h - 2.0 * p0 - p1) / h - g - miss + miss_rate_ * h;
+  const double c3 = ((2.0 * (q0 - q1) / h + p0 + p1) / h) / h - miss_rate_;
+  const auto cubic = [&](double t, double& df) {
+    df = c1 + t * (2.0 * c2 + 3.0 * c3 * t);
+    return c0 + t * (c1 + t * (c2 + t * c3));
+  };
+  // The cubic's own bracket (its values at lo and hi are the model's to the interpolation error),
+  // then Newton kept in it, bisecting when a step leaves it (a grazing arrival: the slope nearly
+  // 0), until the cubic is within a tenth of model_root's tolerance. A polynomial evaluation costs
+  // a few operations against a rotation's hundreds.
+  const double tol = 1e-4 * touch_tol_;
+  double df = 0.0;
+  double a = lo, b = hi;
+  if (!(cubic(a, df) > 0.0 && cubic(b, df) <= 0.0)) return x;
+  double t = x;
+  for (int it = 0; it < 40; ++it) {
+    const double f = cubic(t, df);
+    if (std::abs(f) <= tol) break;
+    (f > 0.0 ? a : b) = t;
+    if (!(b - a > 1e-15 * h)) break;
+    double next = t - f / df;
+    if (!(next > a && next < b)) next = 0.5 * (a + b);
+    t = next;
+  }
+  return t;
+}
+
 double FixedStepper::model_root(const ContactSet& c, double miss, double lo, double hi, double f_lo, double f_hi,
                                 double& g_model) const {
   if (!m_->curved()) {
@@ -306,10 +450,12 @@ double FixedStepper::model_root(const ContactSet& c, double miss, double lo, dou
     // tolerance; fewer evaluations.
     const TorqueFreeRotation& rot = *full_rot_;
     const double curvature =
-        (rot.max_omega() * rot.max_omega() + rot.max_alpha()) * m_->bounding_radius + 2.0 * std::abs(m_->gravity + miss);
+        (rot.max_omega() * rot.max_omega() + rot.max_alpha()) * m_->bounding_radius + 2.0 * std::abs(m_->gravity + miss) +
+        6.0 * std::abs(miss_rate_) * h_;
     const double tol = 1e-3 * touch_tol_;
     double x = hi - f_hi * (hi - lo) / (f_hi - f_lo);
     if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+    if (hermite_) x = hermite_start(miss, lo, hi, x);
     for (int it = 0; it < 100; ++it) {
       Vec3 z_rate;
       const Vec3 z_row = rot.bottom_row(x, z_rate);
@@ -320,7 +466,7 @@ double FixedStepper::model_root(const ContactSet& c, double miss, double lo, dou
       (f > 0.0 ? lo : hi) = x;
       if (!(hi - lo > 1e-15 * h_)) break;
       const double dg = slope + m_->gravity * (h_ - 2.0 * x);  // the model's own slope
-      const double delta = -f / (dg + miss * (h_ - 2.0 * x));
+      const double delta = -f / (dg + (miss + miss_rate_ * x) * (h_ - 2.0 * x) + miss_rate_ * x * (h_ - x));
       const double next = x + delta;
       if (!(next > lo && next < hi)) {
         x = 0.5 * (lo + hi);
@@ -412,6 +558,8 @@ int FixedStepper::step(RigidState& s) {
     if (impact_) imp_ = apply_friction_impact(m, s0, c, /*restitution=*/true, nullptr, nullptr, &geo_);
   }
   rims_new_ = false;
+  miss_rate_ = 0.0;
+  hermite_ = false;
   try_step(s0, c, h_, a_, /*full=*/true);
   const Attempt* done = &a_;
   double dt = h_;
@@ -421,9 +569,11 @@ int FixedStepper::step(RigidState& s) {
     // the free motion) ends with that corner on the floor, G(d) = 0 (G: the lowest such corner's
     // height at the step's end). Each trial is a whole step, so the accepted one keeps every
     // property of a step (energy included). The trials' lengths: the root of the full step's model
-    // of G (model_G: exact without contact, so one trial), then of the model corrected by the last
-    // trial's miss (defect correction, while the model stays bracketing), then Illinois on G
-    // itself in the bracket the trials have found.
+    // of G (model_G: exact without contact, so one trial), corrected for a flat die by the support
+    // solve's predicted share of the kick (predicted_miss: with corners in contact the plain model
+    // missed by 10-1000 touch tolerances and the first trial almost never landed), then of the
+    // model corrected by the last trial's measured miss (defect correction, while the model stays
+    // bracketing), then Illinois on G itself in the bracket the trials have found.
     const Vec3 z_row = s0.R.row(2).transpose();
     double g_lo = std::numeric_limits<double>::infinity();
     if (m.curved()) {
@@ -447,7 +597,34 @@ int FixedStepper::step(RigidState& s) {
     if (modelled) {
       mg_hi = model_G(c, h_);
       mg_d = mg_hi;
-      d = model_root(c, 0.0, 0.0, h_, corrected(mg_lo, 0.0, 0.0), corrected(mg_hi, 0.0, h_), mg_d);
+      // The first trial's length from the model corrected by the support solve's predicted
+      // effect (predicted_miss), the search started from a cubic interpolant of the arriving
+      // corner's motion (hermite_start). Both only move the first trial toward the root.
+      double miss0 = 0.0;
+      if (!m.curved()) {
+        const Vec3 z_end = a_.s.R.row(2).transpose();
+        int arg = -1;
+        double low = std::numeric_limits<double>::infinity();
+        int j = 0;  // c.vertex is ascending
+        for (int i = 0; i < static_cast<int>(m.vertices.size()); ++i) {
+          if (j < c.n && c.vertex[j] == i) {
+            ++j;
+            continue;
+          }
+          const double z = z_end.dot(m.vertices[i]);
+          if (z < low) low = z, arg = i;
+        }
+        if (arg >= 0) {
+          const Vec3 r0 = s0.R * m.vertices[arg], r1 = a_.s.R * m.vertices[arg];
+          hq_[0] = r0.z();
+          hq_[1] = full_w_.cross(r0).z();
+          hq_[2] = r1.z();
+          hq_[3] = a_.s.omega.cross(r1).z();
+          hermite_ = true;
+          if (c.n > 0) miss0 = predicted_miss(c, r0);
+        }
+      }
+      d = model_root(c, miss0, 0.0, h_, corrected(mg_lo, miss0, 0.0), corrected(mg_hi, miss0, h_), mg_d);
       have_mg_d = true;
     }
     bool have_lo = false;
@@ -457,6 +634,7 @@ int FixedStepper::step(RigidState& s) {
     Attempt* lo = &lo_;
     for (int k = 0; k < kMaxTrials; ++k) {
       try_step(s0, c, d, *trial);
+      ++located_trials;
       if (std::abs(trial->G) <= touch_tol_) {
         done = trial;
         dt = d;
@@ -465,7 +643,7 @@ int FixedStepper::step(RigidState& s) {
       const double span = d * (h_ - d);
       const double mgd = have_mg_d ? mg_d : model_G(c, d);
       have_mg_d = false;
-      const double miss = span > 0.0 ? (trial->G - mgd) / span : 0.0;
+      const double miss = span > 0.0 ? (trial->G - mgd) / span - miss_rate_ * d : 0.0;
       const bool above = trial->G > 0.0;
       if (above) {
         d_lo = d, g_lo = trial->G, mg_lo = mgd;
@@ -508,6 +686,7 @@ int FixedStepper::step(RigidState& s) {
         dt = d_lo;
       } else {  // every trial ended below: the shortest, its corner within rounding of the floor
         try_step(s0, c, d_hi, *trial);
+        ++located_trials;
         done = trial;
         dt = d_hi;
       }
@@ -571,6 +750,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->sweeps += st.sweeps;
       stats->steps += steps;
       stats->located += st.located;
+      stats->located_trials += st.located_trials;
       stats->max_energy_gain = std::max(stats->max_energy_gain, st.max_energy_gain);
       stats->max_penetration = std::max(stats->max_penetration, st.max_penetration);
     }

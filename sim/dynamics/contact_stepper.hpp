@@ -70,6 +70,7 @@ class FixedStepper {
   Corrections corrections;        // of every solve and step so far
   std::uint64_t sweeps = 0;       // Gauss-Seidel sweeps of every solve so far
   std::uint64_t located = 0;      // steps shortened to a new contact's instant
+  std::uint64_t located_trials = 0;  // whole trial steps of those shortened steps (the full one not counted)
   double max_energy_gain = 0.0;   // largest relative gain of one impact's kinetic or one step's mechanical energy
   double max_penetration = 0.0;   // curved dice: deepest lowest point below the floor at a step's end (m)
 
@@ -95,9 +96,19 @@ class FixedStepper {
   double model_G(const ContactSet& c, double t) const {
     return lowest_new(c, full_p_, full_v_, *full_rot_, t) + m_->gravity * (h_ - t) * t;
   }
-  // The model corrected by a trial's miss: model_G(t) + miss t (h - t) (the model is exact at
-  // t = 0, the step's start, and at t = h, the full step itself).
-  double corrected(double model_g, double miss, double t) const { return model_g + miss * t * (h_ - t); }
+  // The model corrected by a trial's miss: model_G(t) + (miss + miss_rate_ t) t (h - t) (the model
+  // is exact at t = 0, the step's start, and at t = h, the full step itself; miss_rate_, 0 unless
+  // predicted_miss set it, the miss's first-order change as the arriving corner turns).
+  double corrected(double model_g, double miss, double t) const {
+    return model_g + (miss + miss_rate_ * t) * t * (h_ - t);
+  }
+  // A flat die's prediction of the miss (the corrected model's coefficient) before any shortened
+  // trial: the support solve linearised in the step length at the full step (contact_stepper.cpp).
+  // Sets miss_rate_. r: the arriving corner's lever at the step's start.
+  double predicted_miss(const ContactSet& c, const Vec3& r);
+  // A flat die's starting point for model_root: the root in (lo, hi) of the corrected model with
+  // the arriving corner's rotation replaced by a cubic (contact_stepper.cpp); x if none is found.
+  double hermite_start(double miss, double lo, double hi, double x) const;
   // The root of the corrected model in [lo, hi], given its values f_lo > 0 at lo and f_hi <= 0 at
   // hi: a flat die's by Newton on the model (its slope from the rotation's rate), safeguarded by
   // the bracket; a curved die's by Illinois. g_model: in, model_G(hi); out, model_G at the
@@ -128,6 +139,10 @@ class FixedStepper {
   std::optional<TorqueFreeRotation> full_rot_;   // the full step's free motion (model_G)
   std::optional<TorqueFreeRotation> trial_rot_;  // a shortened trial's
   Vec3 full_p_ = Vec3::Zero(), full_v_ = Vec3::Zero();
+  Vec3 full_w_ = Vec3::Zero();
+  double miss_rate_ = 0.0;
+  bool hermite_ = false;  // hq_ holds the arriving corner's height and rate at t = 0 and h
+  double hq_[4] = {0.0, 0.0, 0.0, 0.0};  // the corrected model's miss grows by this per unit t (predicted_miss)  // the full step's angular velocity after its support solve
   // A curved die whose touching rims the support solve does not push (their material points leave
   // the floor) while the rims' lowest points end the full step below it: another part of the rim
   // is coming down (a near-flat coin whose lowest point runs along the rim, a slap). The rims'
@@ -154,6 +169,7 @@ struct StepperStats {
   std::uint64_t sweeps = 0;
   std::uint64_t steps = 0;
   std::uint64_t located = 0;  // steps shortened to a new contact's instant
+  std::uint64_t located_trials = 0;  // their trial steps of shortened length
   double max_energy_gain = 0.0;
   double max_penetration = 0.0;  // curved dice: deepest lowest point below the floor at a step's end (m)
 };

@@ -31,6 +31,7 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
       probe->pgs_sweeps += stats.sweeps;
       probe->steps += stats.steps;
       probe->located_steps += stats.located;
+      probe->located_trials += stats.located_trials;
       probe->max_energy_gain = std::max(probe->max_energy_gain, stats.max_energy_gain);
       probe->max_penetration = std::max(probe->max_penetration, stats.max_penetration);
     }

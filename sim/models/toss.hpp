@@ -68,6 +68,7 @@ struct TossProbe {
   std::uint64_t pgs_sweeps = 0;
   std::uint64_t steps = 0;
   std::uint64_t located_steps = 0;  // fixed steps shortened to the instant a new corner touches
+  std::uint64_t located_trials = 0;  // their trial steps (each a whole step of shortened length)
   double max_energy_gain = 0.0;
   double max_penetration = 0.0;  // curved dice: deepest rim below the floor at any fixed step's end (m)
   RigidState* final_state = nullptr;           // impulse, stepped: the state when the toss ended
