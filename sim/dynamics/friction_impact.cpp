@@ -261,12 +261,12 @@ bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::V
     const double S2 = Sx * Sx + Sy * Sy, cross = Sx * dy - Sy * dx, dot = Sx * dx + Sy * dy;
     const double g = (Sx * Spy - Sy * Spx) - S2;  // theta' S2
     double theta, step;
-    if (dot < 0.0 && cross * cross < 1e-4 * dot * dot) {
-      // Near the root (|theta| < 0.01, the common case): theta = atan(cross / -dot) by its series,
-      // and the Newton step, with one division between them.
+    if (dot < 0.0 && cross * cross < 1e-2 * dot * dot) {
+      // Near the root (|theta| < 0.1, the common case): theta = atan(cross / -dot) by its series
+      // (to 1e-14 relative), and the Newton step, with one division between them.
       const double inv = 1.0 / (dot * g);
       const double r = -cross * g * inv, r2 = r * r;
-      theta = r * (1.0 - r2 * (1.0 / 3.0 - r2 * 0.2));
+      theta = r * (1.0 - r2 * (1.0 / 3.0 - r2 * (1.0 / 5.0 - r2 * (1.0 / 7.0 - r2 * (1.0 / 9.0 - r2 * (1.0 / 11.0))))));
       step = -theta * S2 * dot * inv;
     } else {
       // (sqrt(x^2 + y^2), not hypot: S is a speed times a compliance, far from overflow.)
