@@ -691,3 +691,69 @@ TEST(FrictionImpact, DirectSolvesAreGaussSeidelsSolution) {
               "difference from Gauss-Seidel %.2g of the speeds\n",
               sliding, sticking, lifted, declined, worst);
 }
+
+// The one-corner sliding solve by Newton on the friction direction's angle against the reference
+// (the fixed point on the direction, then the root search in its angle), on random one-corner
+// states of a homogeneous cube and Die 1's slab layout, mu 0.05-2, fast and slow, spinning or
+// not. Newton's impulse must satisfy the conditions itself (zero final normal velocity, the final
+// slip opposite the friction and parallel to it, |P_t| = mu P_n, to 1e-13 of the speeds) and give
+// the reference's motion; where the reference needed its angle search, too. Where Newton declines
+// (no verified root) the impact law uses the reference: counted, and must stay rare.
+TEST(FrictionImpact, OneCornerNewtonIsTheReferenceSolve) {
+  int sliding = 0, by_angle = 0, newton_declined = 0, both_declined = 0;
+  double worst = 0.0, worst_angle = 0.0;
+  for (int layout = 0; layout < 2; ++layout)
+    for (double mu : {0.05, 0.1, 0.3, 0.6, 1.0, 2.0}) {
+      const DieModel m = layout == 0 ? cube_model(0.5, mu) : slab_model(0.5, mu, 0.5);
+      TossRandom rng(47, static_cast<std::uint64_t>(layout * 1000 + mu * 100));
+      for (int trial = 0; trial < 3000; ++trial) {
+        RigidState s = touching_state(m, rng, trial % 3 == 0 ? 0.0 : trial % 3 == 1 ? 5.0 : 40.0);
+        if (trial % 4 >= 2) {  // slow: a die settling
+          s.velocity *= 0.02;
+          s.omega *= 0.02;
+        }
+        int low = 0;
+        for (int v = 1; v < m.vertex_count(); ++v)
+          if (corner_height(m, s, v) < corner_height(m, s, low)) low = v;
+        const Vec3 r = contact_point(m, s.R, low);
+        const Mat3 inv_I = s.R * m.principal_moments.cwiseInverse().asDiagonal() * s.R.transpose();
+        Mat3 X;
+        X << 0.0, -r.z(), r.y(), r.z(), 0.0, -r.x(), -r.y(), r.x(), 0.0;
+        const Mat3 W = Mat3::Identity() / m.mass - X * inv_I * X;
+        const Vec3 u = s.velocity + s.omega.cross(r);
+        if (!(u.z() < 0.0)) continue;
+        const Vec3 stick = -(W.inverse() * u);
+        if (stick.z() >= 0.0 && std::hypot(stick.x(), stick.y()) <= mu * stick.z()) continue;  // sticks
+        const Eigen::Vector2d d0 = Eigen::Vector2d(-u.x(), -u.y()).normalized();
+        Vec3 Pn, Pr;
+        bool angle = false;
+        const bool ok_n = one_corner_sliding_newton(W, u, mu, d0, Pn);
+        const bool ok_r = one_corner_sliding_reference(W, u, mu, d0, Pr, &angle);
+        ++sliding;
+        by_angle += angle;
+        if (!ok_n) {
+          ++newton_declined;
+          both_declined += !ok_r;
+          continue;
+        }
+        const Vec3 after = u + W * Pn;
+        const double scale = u.norm() + (W * Pn).norm();
+        const Eigen::Vector2d slip(after.x(), after.y()), f(Pn.x(), Pn.y());
+        EXPECT_LE(std::abs(after.z()), 1e-13 * scale);
+        EXPECT_NEAR(f.norm(), mu * Pn.z(), 1e-14 * mu * Pn.z());
+        EXPECT_LT(slip.dot(f), 0.0);
+        EXPECT_LE(std::abs(slip.x() * f.y() - slip.y() * f.x()) / f.norm(), 1e-13 * scale);
+        ASSERT_TRUE(ok_r) << "the reference found no root where Newton did";
+        const double diff = (W * (Pn - Pr)).norm() / scale;
+        worst = std::max(worst, diff);
+        if (angle) worst_angle = std::max(worst_angle, diff);
+        EXPECT_LE(diff, 1e-8) << "layout " << layout << ", mu " << mu << ", trial " << trial;
+      }
+    }
+  EXPECT_GT(sliding, 15000);
+  EXPECT_GT(by_angle, 20);                     // the reference's hard cases are in the sample
+  EXPECT_LE(newton_declined, sliding / 1000);  // the fallback stays rare
+  std::printf("one-corner sliding: %d states, %d needed the reference's angle search; Newton declined %d (the "
+              "reference too: %d); worst velocity difference %.2g of the speeds (angle-search cases %.2g)\n",
+              sliding, by_angle, newton_declined, both_declined, worst, worst_angle);
+}

@@ -6,7 +6,9 @@
 
 #include <Eigen/QR>
 
+#include "sim/atan.hpp"
 #include "sim/dynamics/contact.hpp"
+#include "sim/illinois.hpp"
 
 namespace dicesim {
 namespace {
@@ -65,14 +67,20 @@ Eigen::Vector2d min_on_disc(const Eigen::Matrix2d& A, const Eigen::Vector2d& g, 
   if (x0.squaredNorm() <= radius * radius) return x0;
   // Eigen-decomposition of the 2x2 (closed form).
   const double mean = 0.5 * (a + c), diff = 0.5 * (a - c);
-  const double root = std::hypot(diff, b);
+  // (sqrt(x^2 + y^2), not hypot: compliances, far from overflow.)
+  const double root = std::sqrt(diff * diff + b * b);
   const double l1 = mean - root, l2 = mean + root;  // ascending
   // Eigenvector of l1 from the better-conditioned row of (A - l1 1) q1 = 0.
   Eigen::Vector2d q1(1.0, 0.0);
   if (root > 0.0) q1 = (diff >= 0.0 ? Eigen::Vector2d(b, -(diff + root)) : Eigen::Vector2d(root - diff, -b)).normalized();
   const Eigen::Vector2d q2(-q1.y(), q1.x());
   const double c1 = q1.dot(g), c2 = q2.dot(g);
-  double lambda = 0.0;
+  // From the largest of two lower bounds of the root, |g| / radius - l2 and |c1| / radius - l1 (if
+  // positive): still left of it, |x(lambda)| >= radius there, since
+  // |x|^2 = c1^2 / (l1 + lambda)^2 + c2^2 / (l2 + lambda)^2 >= |g|^2 / (l2 + lambda)^2 and
+  // >= c1^2 / (l1 + lambda)^2. (From 0 it took 4.1 iterations per Die 1 solve, from these 2.x.)
+  const double inv_radius = 1.0 / radius;
+  double lambda = std::max({0.0, std::sqrt(c1 * c1 + c2 * c2) * inv_radius - l2, std::abs(c1) * inv_radius - l1});
   for (int it = 0; it < 60; ++it) {
     const double d1 = l1 + lambda, d2 = l2 + lambda;
     const double y1 = c1 / d1, y2 = c2 / d2;
@@ -81,11 +89,15 @@ Eigen::Vector2d min_on_disc(const Eigen::Matrix2d& A, const Eigen::Vector2d& g, 
     if (std::abs(norm - radius) <= 1e-14 * radius) break;
     // phi = 1/|x| - 1/radius, phi' = (sum c_i^2 / d_i^3) / |x|^3: Newton from the left of the root
     // increases lambda monotonically (phi is concave there).
-    const double phi = 1.0 / norm - 1.0 / radius;
+    const double phi = 1.0 / norm - inv_radius;
     const double dphi = (y1 * y1 / d1 + y2 * y2 / d2) / (norm2 * norm);
     const double next = std::max(0.0, lambda - phi / dphi);
     if (next == lambda) break;
+    // Quadratic convergence: a step this small leaves an error ~ its square, below rounding,
+    // so the point it lands on is not evaluated again.
+    const bool last = std::abs(next - lambda) <= 1e-8 * (l1 + next);
     lambda = next;
+    if (last) break;
   }
   Eigen::Vector2d x = -(c1 / (l1 + lambda)) * q1 - (c2 / (l2 + lambda)) * q2;
   const double xn = x.norm();
@@ -139,40 +151,26 @@ bool sliding_impulse_by_angle(const Mat3& W, const Vec3& u, double mu, Eigen::Ve
         const Eval e0 = prev[side_index];
         prev[side_index] = enext;
         if (!e0.ok || !enext.ok || (e0.g > 0.0) == (enext.g > 0.0)) continue;
-        double lo = std::min(x0, x1), hi = std::max(x0, x1);
         Eval elo = x0 < x1 ? e0 : enext, eh = x0 < x1 ? enext : e0;
-        // Illinois (regula falsi halving the stale end's weight): superlinear, never leaves
-        // the bracket; a bisection step if an interior point leaves the valid set.
-        double glo = elo.g, ghi = eh.g;
-        int side = 0;
+        // Illinois (never leaves the bracket); a bisection step if an interior point leaves the
+        // valid set.
+        Illinois br{std::min(x0, x1), elo.g, std::max(x0, x1), eh.g};
         bool valid = true;
-        for (int it = 0; it < 200 && hi - lo > 1e-13 && elo.g != 0.0 && eh.g != 0.0; ++it) {
-          double mid = hi - ghi * (hi - lo) / (ghi - glo);
-          if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
+        for (int it = 0; it < 200 && br.hi - br.lo > 1e-13 && elo.g != 0.0 && eh.g != 0.0; ++it) {
+          double mid = br.next();
           Eval em = eval(mid);
           if (!em.ok) {
-            mid = 0.5 * (lo + hi);
+            mid = 0.5 * (br.lo + br.hi);
             em = eval(mid);
             if (!em.ok) {
               valid = false;  // the bracket holds an invalid stretch: look further
               break;
             }
           }
-          if ((em.g > 0.0) == (elo.g > 0.0)) {
-            if (mid == lo) break;
-            lo = mid;
-            elo = em;
-            glo = em.g;
-            if (side == -1) ghi *= 0.5;
-            side = -1;
-          } else {
-            if (mid == hi) break;
-            hi = mid;
-            eh = em;
-            ghi = em.g;
-            if (side == 1) glo *= 0.5;
-            side = 1;
-          }
+          const bool lo_side = (em.g > 0.0) == (elo.g > 0.0);
+          if (mid == (lo_side ? br.lo : br.hi)) break;
+          (lo_side ? elo : eh) = em;
+          br.update(mid, em.g, lo_side);
         }
         if (!valid) continue;
         const Eval& best = std::abs(elo.g) <= std::abs(eh.g) ? elo : eh;
@@ -184,36 +182,11 @@ bool sliding_impulse_by_angle(const Mat3& W, const Vec3& u, double mu, Eigen::Ve
   return false;
 }
 
-// The same problem for one point, exactly: the sticking impulse if it lies in the cone, else
-// sliding: P = lambda (n + mu d) with the final slip -s d (s >= 0, maximal dissipation) and zero
-// final normal velocity; d from up to eight fixed-point iterations on its direction,
-// Anderson-accelerated (depth 1), then, where that has not converged, the angle root-finder
-// above. Returns false (the caller falls back to the iterative solver) only for a jam.
-bool solve_plastic_single(const Body& b, const Points& pts, double pn[], Eigen::Vector2d pt[]) {
-  const Vec3& r = pts.r[0];
-  const Vec3 u = b.point_velocity(r);
-  pn[0] = 0.0;
-  pt[0].setZero();
-  if (u.z() >= 0.0) return true;  // separating: no impulse
-  const Vec3 stick = -(pts.W0_inverse * u);
-  const double mu = pts.mu[0];
-  if (stick.z() >= 0.0 && std::hypot(stick.x(), stick.y()) <= mu * stick.z()) {
-    b.apply(r, stick);
-    pn[0] = stick.z();
-    pt[0] = Eigen::Vector2d(stick.x(), stick.y());
-    return true;
-  }
-  if (mu == 0.0) {
-    const Vec3 P(0.0, 0.0, -u.z() * pts.inv_wnn[0]);
-    b.apply(r, P);
-    pn[0] = P.z();
-    return true;
-  }
-  Eigen::Vector2d d(-u.x(), -u.y());
-  if (d.norm() <= 1e-300) d = Eigen::Vector2d(stick.x(), stick.y());
-  if (d.norm() <= 1e-300) return false;
-  d.normalize();
-  const Mat3& W = pts.W0;
+}  // namespace
+
+bool one_corner_sliding_reference(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d, Vec3& P,
+                                  bool* by_angle) {
+  if (by_angle) *by_angle = false;
   Eigen::Vector2d prev_r(0.0, 0.0), prev_nd(0.0, 0.0);
   for (int it = 0; it < 8; ++it) {
     const Vec3 dir(mu * d.x(), mu * d.y(), 1.0);
@@ -226,10 +199,7 @@ bool solve_plastic_single(const Body& b, const Points& pts, double pn[], Eigen::
     if (slip <= 1e-300) break;
     nd /= slip;
     if ((nd - d).norm() <= 1e-10) {
-      const Vec3 P = lambda * dir;
-      b.apply(r, P);
-      pn[0] = P.z();
-      pt[0] = Eigen::Vector2d(P.x(), P.y());
+      P = lambda * dir;
       return true;
     }
     // Anderson mixing (depth 1) of the last two residuals; the acceptance test is unchanged.
@@ -247,10 +217,141 @@ bool solve_plastic_single(const Body& b, const Points& pts, double pn[], Eigen::
     d = xn > 0.0 && std::isfinite(xn) ? Eigen::Vector2d(x / xn) : nd;
   }
   // The fixed point converges slowly or cycles (it does where W couples slip and normal
-  // strongly; with two plain iterations ~15% of sliding impacts of Die 1 came here): solve the
-  // same equations as a root in the angle of d instead, from the last iterate.
+  // strongly): solve the same equations as a root in the angle of d instead, from the last iterate.
+  if (by_angle) *by_angle = true;
+  return sliding_impulse_by_angle(W, u, mu, d, P);
+}
+
+// The direction condition in d's angle phi. With m = -u_z, W's blocks A (2x2 tangential), b
+// (its tangential-normal column) and a = W_nn, the normal impulse is lambda = m / den,
+// den = a + mu b.d, and the final slip s = S / den, S = den u_t + m (b + mu A d) (the quartic in
+// tan(phi / 2) of the closed form is S x d = 0; but its roots include the invalid ones, slip along
+// the friction). The residual taken is q = tan(theta / 2), theta the angle from d to -S:
+// q = (S x d) / (|S| - S.d), zero only where the slip opposes the friction (theta = 0), infinite
+// at the invalid roots (theta = pi). q' = (1 + q^2) theta' / 2 with theta' = (S x S') / |S|^2 - 1,
+// S' = mu (b.d') u_t + m mu A d', d' = perp(d). Newton in phi, each step taken as
+// d <- (d + delta d') / sqrt(1 + delta^2) (the angle atan(delta): delta to third order, so the
+// convergence stays quadratic, and no sin/cos), delta capped at 1 (45 degrees). The fixed point
+// d <- -S / |S| is the step delta = theta: Newton's is theta / (1 - arg'(S)), exact where the map
+// is linear. From the sliding direction, as the fixed point started; the root is then verified
+// (den > 0, the final slip opposite d and perpendicular to it to 1e-13 of the speeds), else false.
+bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d, Vec3& P) {
+  const double m = -u.z();
+  const double a = W(2, 2), bx = W(0, 2), by = W(1, 2);
+  const double A00 = W(0, 0), A01 = W(0, 1), A11 = W(1, 1);
+  const double ux = u.x(), uy = u.y();
+  // d turned by atan(t): (d + t d') / sqrt(1 + t^2); for small t the inverse root by its series
+  // (to 3e-17: the latency of a square root and a division saved in the common last steps).
+  const auto turn = [](const Eigen::Vector2d& v, double t) {
+    const double t2 = t * t;
+    const double c = t2 < 1e-4 ? 1.0 - t2 * (0.5 - t2 * (0.375 - t2 * 0.3125)) : 1.0 / std::sqrt(1.0 + t2);
+    return Eigen::Vector2d((v.x() - t * v.y()) * c, (v.y() + t * v.x()) * c);
+  };
+  bool converged = false;
+  Eigen::Vector2d d_prev = d;
+  double theta_prev = 0.0, step_prev = 0.0;
+  for (int it = 0; it < 40; ++it) {
+    const double dx = d.x(), dy = d.y();  // d' = (-dy, dx)
+    const double den = a + mu * (bx * dx + by * dy);
+    if (!(den > 0.0)) return false;
+    const double bdp = by * dx - bx * dy;
+    const double Sx = den * ux + m * (bx + mu * (A00 * dx + A01 * dy));
+    const double Sy = den * uy + m * (by + mu * (A01 * dx + A11 * dy));
+    const double Spx = mu * (bdp * ux + m * (A01 * dx - A00 * dy));
+    const double Spy = mu * (bdp * uy + m * (A11 * dx - A01 * dy));
+    const double S2 = Sx * Sx + Sy * Sy, cross = Sx * dy - Sy * dx, dot = Sx * dx + Sy * dy;
+    const double g = (Sx * Spy - Sy * Spx) - S2;  // theta' S2
+    double theta, step;
+    if (dot < 0.0 && cross * cross < 1e-2 * dot * dot) {
+      // Near the root (|theta| < 0.1, the common case): theta = atan(cross / -dot) by its series
+      // (to 1e-14 relative), and the Newton step, with one division between them.
+      const double inv = 1.0 / (dot * g);
+      const double r = -cross * g * inv, r2 = r * r;
+      theta = r * (1.0 - r2 * (1.0 / 3.0 - r2 * (1.0 / 5.0 - r2 * (1.0 / 7.0 - r2 * (1.0 / 9.0 - r2 * (1.0 / 11.0))))));
+      step = -theta * S2 * dot * inv;
+    } else {
+      // (sqrt(x^2 + y^2), not hypot: S is a speed times a compliance, far from overflow.)
+      const double Sn = std::sqrt(S2);
+      const double q = cross / (Sn - dot);  // tan(theta / 2): finite except at theta = pi
+      const double q2 = q * q;
+      theta = q2 < 1e-2 ? 2.0 * q * (1.0 - q2 * (1.0 / 3.0 - q2 * (0.2 - q2 * (1.0 / 7.0)))) : 2.0 * atan_fixed(q);  // not libm: the same bits on every CPU (sim/atan.hpp)
+      step = -theta * S2 / g;
+    }
+    if (it > 0 && !(std::abs(theta) < std::abs(theta_prev))) {
+      // No decrease: back to the last iterate with half the step (a safeguard; rare).
+      step_prev *= 0.5;
+      if (!(std::abs(step_prev) > 1e-9)) return false;
+      d = turn(d_prev, step_prev);
+      continue;
+    }
+    d_prev = d;
+    theta_prev = theta;
+    if (!(g < -0.25 * S2)) {
+      // theta nearly flat or rising (theta' >= -1/4): Newton's step is no guide. The fixed
+      // point's instead, d <- -S / |S| (the turn by theta), which the next iterate must improve on.
+      step_prev = std::abs(theta) >= 0.25 * M_PI ? (theta > 0.0 ? 1.0 : -1.0) : std::tan(theta);
+      d = Eigen::Vector2d(-Sx, -Sy) * (1.0 / std::sqrt(S2));
+      continue;
+    }
+    if (!std::isfinite(step)) return false;
+    step = std::clamp(step, -1.0, 1.0);
+    step_prev = step;
+    d = turn(d, step);
+    // The next step would be ~ step^2 theta'' / theta': below rounding.
+    if (std::abs(step) <= 1e-9) {
+      converged = true;
+      break;
+    }
+  }
+  if (!converged) return false;
+  const Vec3 dir(mu * d.x(), mu * d.y(), 1.0);
+  const Vec3 Wd = W * dir;
+  if (!(Wd.z() > 0.0)) return false;
+  const double lambda = m / Wd.z();
+  const double sx = ux + lambda * Wd.x(), sy = uy + lambda * Wd.y();
+  // (sqrt(x^2 + y^2) rather than hypot: speeds of m/s scale cannot overflow or underflow.)
+  const double scale = std::sqrt(u.squaredNorm()) + lambda * std::sqrt(Wd.squaredNorm());
+  if (!(sx * d.x() + sy * d.y() < 0.0)) return false;                   // the slip opposes the friction
+  if (!(std::abs(sx * d.y() - sy * d.x()) <= 1e-13 * scale)) return false;  // and is anti-parallel to it
+  P = lambda * dir;
+  return true;
+}
+
+namespace {
+
+// The same problem for one point, exactly: the sticking impulse if it lies in the cone, else
+// sliding: P = lambda (n + mu d) with the final slip -s d (s >= 0, maximal dissipation) and zero
+// final normal velocity; d by Newton on its angle (one_corner_sliding_newton), and where that
+// does not verify, the fixed point and angle search (one_corner_sliding_reference). Returns false
+// (the caller falls back to the iterative solver) only for a jam.
+bool solve_plastic_single(const Body& b, const Points& pts, double pn[], Eigen::Vector2d pt[]) {
+  const Vec3& r = pts.r[0];
+  const Vec3 u = b.point_velocity(r);
+  pn[0] = 0.0;
+  pt[0].setZero();
+  if (u.z() >= 0.0) return true;  // separating: no impulse
+  const Vec3 stick = -(pts.W0_inverse * u);
+  const double mu = pts.mu[0];
+  // (Squared: impulses of N s scale cannot overflow.)
+  if (stick.z() >= 0.0 && stick.x() * stick.x() + stick.y() * stick.y() <= mu * mu * stick.z() * stick.z()) {
+    b.apply(r, stick);
+    pn[0] = stick.z();
+    pt[0] = Eigen::Vector2d(stick.x(), stick.y());
+    return true;
+  }
+  if (mu == 0.0) {
+    const Vec3 P(0.0, 0.0, -u.z() * pts.inv_wnn[0]);
+    b.apply(r, P);
+    pn[0] = P.z();
+    return true;
+  }
+  Eigen::Vector2d d(-u.x(), -u.y());
+  if (d.norm() <= 1e-300) d = Eigen::Vector2d(stick.x(), stick.y());
+  if (d.norm() <= 1e-300) return false;
+  d.normalize();
   Vec3 P;
-  if (!sliding_impulse_by_angle(W, u, mu, d, P)) return false;
+  if (!one_corner_sliding_newton(pts.W0, u, mu, d, P) && !one_corner_sliding_reference(pts.W0, u, mu, d, P))
+    return false;
   b.apply(r, P);
   pn[0] = P.z();
   pt[0] = Eigen::Vector2d(P.x(), P.y());

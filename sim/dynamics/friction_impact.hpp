@@ -114,6 +114,17 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
                                    const ContactImpulses* warm = nullptr, ContactImpulses* out = nullptr,
                                    ContactGeometry* geometry = nullptr, bool direct = true);
 
+// The one-corner plastic sliding impulse P = lambda (mu d, 1) (d a unit friction direction):
+// zero final normal velocity u + W P, final slip anti-parallel to d. W the point's compliance, u
+// its velocity before (u_z < 0), d0 the starting direction (opposite the slip before). The
+// impact law uses the Newton solve and falls back to the reference (a fixed point on d, then a
+// root search in its angle) where Newton's root does not verify; both exposed for the tests
+// that compare them. False: no root (Newton: none verified; reference: a jam).
+bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d0, Vec3& P);
+// (by_angle: set when the reference needed its angle search.)
+bool one_corner_sliding_reference(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d0, Vec3& P,
+                                  bool* by_angle = nullptr);
+
 // Velocity of corner `vertex`'s contact point (world).
 inline Vec3 corner_velocity(const DieModel& m, const RigidState& s, int vertex) {
   return s.velocity + s.omega.cross(contact_point(m, s.R, vertex));
