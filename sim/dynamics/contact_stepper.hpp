@@ -12,9 +12,9 @@
 // Energy: no step gains mechanical energy E = kinetic + m g z_com (the rotation is exact, a step
 // without contact loses m g^2 h^2 / 2, the plastic solve after gravity's kick loses at least
 // (F - m g h)^2 / 2m with F its normal impulse, and no impact gains). `max_energy_gain` records
-// the largest relative gain seen, for the tests. (A curved die's rolling support, which asks the
-// rim for the upward speed that keeps its lowest point on the floor, is capped to keep this too:
-// rim_support.)
+// the largest relative gain seen, for the tests. (A curved die's rim, whose lowest point is not a
+// material point, is held on the floor by an impulse at the step's middle that does no work to
+// second order; checked, and capped if it would gain: rim_support, curvature_support.)
 #pragma once
 
 #include <optional>
@@ -91,7 +91,9 @@ class FixedStepper {
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
   // A curved die's support solve for a step of length d (gravity's kick already in s): the plastic
   // solve, rolling resistance, and the touching rims' lowest points held on the floor at the
-  // step's end (contact_stepper.cpp). Leaves rot built for s's free motion.
+  // step's end by the curvature impulse at the step's middle (contact_stepper.cpp). Leaves s and
+  // rot such that rot's free motion of s for d is the step's motion. full: the step of length h
+  // (it decides rims_new_).
   void rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
                    std::optional<TorqueFreeRotation>& rot, bool full);
   // Its parts: the solve at the step's start (plastic, biased to hold the rims on the floor), and
