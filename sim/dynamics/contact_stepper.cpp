@@ -115,23 +115,13 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   a.impact = impact_;
   if (impact_) a.imp = imp_;
   a.next.n = 0;
+  a.capped = false;
   s.velocity.z() -= m.gravity * d;
   // Built in place (the full step's is kept for model_G; the object is large, so no copies). A
   // curved die's support solve builds its own (rim_support: the rotation is part of its search).
   std::optional<TorqueFreeRotation>& slot = full ? full_rot_ : trial_rot_;
   const bool built = m.curved() && c.n > 0;
-  if (built) {
-    rim_support(s, c, d, mechanical_energy(m, s0), a, slot);
-    if (full && !slap_located_ && !(a.sup.normal_impulse > 0.0)) {
-      // Leaving (no push) and first rising, yet below the floor at the step's end: the sinking is
-      // another part of the rim arriving (rims_new_).
-      const double eps = 1e-3 * d;
-      const double z0 = s.position.z() + rim_lowest(m, s.R);
-      const double z1 = s.position.z() + s.velocity.z() * eps + rim_lowest(m, slot->orientation(eps));
-      const double zd = s.position.z() + s.velocity.z() * d + rim_lowest(m, slot->orientation(d));
-      rims_new_ = z1 > z0 && zd < -touch_tol_;
-    }
-  }
+  if (built) rim_support(s, c, d, mechanical_energy(m, s0), a, slot, full);
   if (!m.curved() && c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
 
   // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact). A trial of
@@ -184,24 +174,170 @@ double rim_low_z(const DieModel& m, const Vec3& z_row, int rim) {
 }  // namespace
 
 void FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
-                               std::optional<TorqueFreeRotation>& rot) {
-  // A rim's lowest point is not a material point: the plastic solve stops the normal velocity of
-  // the material point there, but over the step the rim's lowest point moves along the rim and
-  // can end below the floor (a wobbling coin's sank by up to 0.1 mm a step, and it accumulated
-  // to millimetres). So the solve asks the touching points for the upward speed b that brings
-  // the touching rims' lowest points back to the floor at the step's end: v_n >= b instead of
-  // v_n >= 0 (the same solve with the velocity shifted by -b e_z, then restored: tangential
-  // velocities and friction are unchanged by the shift), b the root of the exact gap at the
-  // step's end (the step's own free motion) in b, bracketed, by Illinois: the gap grows with b at
-  // rate d to first order (the shift raises every point by b d; only the solve's change of the
-  // spin acts on the sinking). The constraint's centripetal part, as an impulse. The same from
-  // above when the plain solve leaves the rims above the floor at the step's end (b < 0: less
-  // push, down to none). b = 0 (the plain
-  // solve) whenever the rims end the step on the floor without it, and whenever the plain solve
-  // does not push (the touching material point leaves the floor): then the sinking is another
-  // part of the rim coming down (a coin slapping flat), and asking the leaving point for more
-  // upward speed would push where nothing touches and gain energy (up to 70 % of a step's in
-  // trials); step() lifts that residual instead, counted (overlap_fixes).
+                               std::optional<TorqueFreeRotation>& rot, bool full) {
+  start_support(s, c, d, e_start, a, rot);
+  const DieModel& m = *m_;
+  if (!(d > 0.0)) return;
+  if (full && !slap_located_ && !(a.sup.normal_impulse > 0.0)) {
+    // Leaving (no push) and first rising, yet below the floor at the step's end: the sinking is
+    // another part of the rim arriving (rims_new_).
+    const double eps = 1e-3 * d;
+    const double z0 = s.position.z() + rim_lowest(m, s.R);
+    const double z1 = s.position.z() + s.velocity.z() * eps + rim_lowest(m, rot->orientation(eps));
+    const double zd = s.position.z() + s.velocity.z() * d + rim_lowest(m, rot->orientation(d));
+    rims_new_ = z1 > z0 && zd < -touch_tol_;
+  }
+  // The step being located to that arrival (its trials included) takes no curvature impulse: its
+  // end is where the arriving part touches.
+  if (!rims_new_) curvature_support(s, c, d, e_start, a, rot);
+}
+
+void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
+                                     std::optional<TorqueFreeRotation>& rot) {
+  // What the start's solve leaves sinking (its touching material point leaves the floor, or the
+  // bias was capped): the rim's lowest point, not a material point, goes down to second order
+  // while the point that touched rises. The exact constraint is on the lowest point's height
+  // phi(t), whose rate is the normal velocity of the material point there (envelope theorem) and
+  // whose second derivative has the rim's curvature term on top of that point's acceleration.
+  // Held at phi(0) = phi(d) = 0 by one impulse at the step's middle, tau = d / 2, at the rim's
+  // lowest point there, asking v_n+ >= b with b the root of the exact end-of-step gap: with phi
+  // quadratic over the step (phi'' = -k), phi(tau) = phi(0) + v0 tau - k tau^2 / 2 and the point
+  // arrives at v- = v0 - k tau, so the end gap asks b = -v- - 2 phi(0) / d: the impulse reflects
+  // the point's normal velocity, and its normal work P (v- + b) / 2 = -P phi(0) / d <= 0 (a
+  // start on or above the floor). The constraint force of the continuous motion does no work
+  // either (it acts on the material point at the lowest point, whose normal velocity phi' is 0 in
+  // contact): this is its impulse, placed where its work vanishes. (At the start, tau = 0, the
+  // same target pushes a point that is leaving: v- = v0 >= 0, b = k d / 2, a gain of P (v0 + b)/2.)
+  // If the lowest point is above the floor at d / 2 (it first rose), tau is where it comes back,
+  // phi(tau) = 0, the arriving part's instant. Not exact beyond second order, so the step's
+  // energy is checked as the start's bias is (no gain; b capped, the residual lifted and counted
+  // in step()).
+  const DieModel& m = *m_;
+  bool rim_in[2] = {false, false};
+  for (int i = 0; i < c.n; ++i) rim_in[c.vertex[i] < 3 ? 0 : 1] = true;
+  const Vec3 p0 = s.position, v0 = s.velocity;
+  const TorqueFreeRotation& r0 = *rot;
+  const auto phi = [&](double t) {  // the touching rims' lowest point at t of the start's free motion
+    const Vec3 z_row = r0.bottom_row(t);
+    double z = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < 2; ++r)
+      if (rim_in[r]) z = std::min(z, p0.z() + v0.z() * t + rim_low_z(m, z_row, r));
+    return z;
+  };
+  if (!(phi(d) < 0.0)) return;
+  double tau = 0.5 * d;
+  const double f_mid = phi(tau);
+  if (f_mid > touch_tol_) {  // it rose first: where it comes back down, in (d / 2, d)
+    Illinois br{tau, f_mid, d, phi(d)};
+    for (int k = 0; k < 40 && br.hi - br.lo > 1e-12 * d; ++k) {
+      const double x = br.next();
+      const double f = phi(x);
+      if (std::abs(f) <= 1e-3 * touch_tol_) {
+        br.lo = br.hi = x;
+        break;
+      }
+      br.update(x, f, /*lo_side=*/f > 0.0);
+    }
+    tau = br.lo;
+  }
+  // The state at tau (free motion), and the lowest features of the touching rims there.
+  RigidState mid = s;
+  Vec3 w_tau;
+  r0.state(tau, mid.R, w_tau);
+  mid.omega = w_tau;
+  mid.position = p0 + tau * v0;
+  ContactSet cm;
+  for (int r = 0; r < 2; ++r)
+    if (rim_in[r]) cm.vertex[cm.n++] = 3 * r;
+  const double rest = d - tau;
+  const RigidState base = mid;
+  TorqueFreeRotation r1;
+  ImpactResult res;
+  int sweeps = 0;
+  const auto solve = [&](double b) {
+    mid = base;
+    mid.velocity.z() -= b;
+    res = apply_friction_impact(m, mid, cm, /*restitution=*/false);
+    mid.velocity.z() += b;
+    sweeps += res.iterations;
+    apply_rolling_resistance(m, mid, cm, res.normal_impulse);
+    r1 = TorqueFreeRotation(m.principal_moments, mid.R, world_inertia(m, mid.R) * mid.omega);
+    const Vec3 z_row = r1.bottom_row(rest);
+    double gap = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < 2; ++r)
+      if (rim_in[r]) gap = std::min(gap, mid.position.z() + mid.velocity.z() * rest + rim_low_z(m, z_row, r));
+    return gap;
+  };
+  const auto energy_end = [&] {
+    return kinetic_energy(m, mid) + m.mass * m.gravity * (mid.position.z() + mid.velocity.z() * rest);
+  };
+  double g = solve(0.0);
+  double b = 0.0;
+  if (g < 0.0 && rest > 0.0) {
+    double lo = 0.0, g_lo = g, hi = -g / rest, g_hi = solve(hi);
+    for (int k = 0; k < 8 && g_hi < -touch_tol_; ++k) {
+      lo = hi, g_lo = g_hi;
+      hi *= 2.0;
+      g_hi = solve(hi);
+    }
+    Illinois br{lo, g_lo, hi, g_hi};
+    b = hi;
+    g = g_hi;
+    // Accepted on the floor or above it, within the touch tolerance (one-sided: the next step then
+    // starts with phi(0) >= 0, where the impulse's work is <= 0).
+    const auto accepted = [&](double x) { return x >= 0.0 && x <= touch_tol_; };
+    for (int k = 0; k < 20 && !accepted(g) && br.f_hi > 0.0; ++k) {
+      b = br.next();
+      g = solve(b);
+      br.update(b, g, /*lo_side=*/g < 0.0);
+    }
+    if (!accepted(g) && b != br.hi) {
+      b = br.hi;
+      g = solve(b);
+    }
+  }
+  if (energy_end() > e_start) {  // the largest b that gains nothing (b = 0, the plain solve, never gains)
+    double ok = 0.0, bad = b;
+    for (int k = 0; k < 20; ++k) {
+      const double x = 0.5 * (ok + bad);
+      solve(x);
+      (energy_end() > e_start ? bad : ok) = x;
+    }
+    b = ok;
+    g = solve(b);
+    ++curvature_capped;
+    a.capped = g < -touch_tol_;
+  }
+  ++curvature_impulses;
+  a.sup.corrections.add(res.corrections);
+  a.sup.iterations += sweeps;
+  a.sup.normal_impulse += res.normal_impulse;
+  // As a state at the step's start whose free motion for d is the motion after the impulse: the
+  // post-impulse motion run back by tau (time reversal: the rotation under -L), so that try_step's
+  // free motion, its end state and its lowest-point searches need no second piece.
+  s = mid;
+  Vec3 w_back;
+  TorqueFreeRotation(m.principal_moments, mid.R, -(world_inertia(m, mid.R) * mid.omega)).state(tau, s.R, w_back);
+  s.omega = -w_back;
+  s.position = mid.position - tau * mid.velocity;
+  rot.emplace(m.principal_moments, s.R, world_inertia(m, s.R) * s.omega);
+}
+
+void FixedStepper::start_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
+                                 std::optional<TorqueFreeRotation>& rot) {
+  // The plastic solve at the step's start stops the touching material points' approach. A rim's
+  // lowest point is not a material point: over the step it moves along the rim, and with the
+  // touching point stopped it sinks (curvature_support) or rises. Rising: the plain solve pushed
+  // harder than the rim needs to stay on the floor (the contact point's centripetal acceleration,
+  // -w x (w x r), points up toward the COM, and over the step it lifts the point by about
+  // w^2 r h^2 / 2; a rolling coin hopped off the floor every other step). Then the solve asks for
+  // v_n >= b with b < 0 (the same solve on the velocity shifted by -b e_z, then restored: the
+  // tangential velocities and friction are unchanged by the shift), the push reduced until the
+  // rims end the step on the floor, or no push at all (then the die really leaves). Its kinetic
+  // energy change is the shifted solve's (<= 0, plastic) plus b times the normal impulse (<= 0).
+  // (Sinking was once treated here the same way, b > 0: that pushes a point that already leaves
+  // the floor, gains energy, and had to be capped, its residual lifted; the curvature impulse
+  // at the step's middle does it without work.)
   const DieModel& m = *m_;
   const RigidState base = s;
   bool rim_in[2] = {false, false};
@@ -222,63 +358,34 @@ void FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, dou
     return gap;
   };
   const double g0 = solve(0.0);
-  if (!(d > 0.0) || std::abs(g0) <= touch_tol_ || !(a.sup.normal_impulse > 0.0)) {
+  if (!(d > 0.0) || g0 <= touch_tol_ || !(a.sup.normal_impulse > 0.0)) {
     a.sup.iterations = sweeps;
     return;
   }
-  double b = 0.0;
-  if (g0 < 0.0) {
-    // Sinking. Bracket: from the first-order guess, doubling (every point rises by at least ~b d
-    // for large b).
-    double lo = 0.0, g_lo = g0, hi = -g0 / d, g_hi = solve(hi);
-    for (int k = 0; k < 8 && g_hi < -touch_tol_; ++k) {
-      lo = hi, g_lo = g_hi;
-      hi *= 2.0;
-      g_hi = solve(hi);
-    }
+  double hi = 0.0, g_hi = g0, lo = -g0 / d, g_lo = solve(lo);
+  for (int k = 0; k < 8 && g_lo > touch_tol_ && a.sup.normal_impulse > 0.0; ++k) {
+    hi = lo, g_hi = g_lo;
+    lo *= 2.0;
+    g_lo = solve(lo);
+  }
+  double b = lo;
+  if (g_lo < -touch_tol_) {
     Illinois br{lo, g_lo, hi, g_hi};
-    b = hi;
-    double g = g_hi;
-    for (int k = 0; k < 12 && std::abs(g) > touch_tol_ && br.f_hi > 0.0; ++k) {
+    double g = g_lo;
+    for (int k = 0; k < 12 && std::abs(g) > touch_tol_; ++k) {
       b = br.next();
       g = solve(b);
       br.update(b, g, /*lo_side=*/g < 0.0);
     }
-    if (std::abs(g) > touch_tol_ && b != br.hi) {  // not converged: the bracket's end above the floor
+    if (g < -touch_tol_) {  // not converged: the bracket's end above the floor
       b = br.hi;
       solve(b);
     }
-  } else {
-    // Rising: the plain solve pushed harder than the rim needs to stay on the floor (the contact
-    // point's centripetal acceleration, -w x (w x r), points up toward the COM, and over the step it
-    // lifts the point by about w^2 r h^2 / 2; the rolling coin hopped off the floor every other
-    // step). The same constraint from above: v_n >= b with b < 0, the push reduced until the
-    // rims end the step on the floor, or no push at all (then the die really leaves the floor).
-    double hi = 0.0, g_hi = g0, lo = -g0 / d, g_lo = solve(lo);
-    for (int k = 0; k < 8 && g_lo > touch_tol_ && a.sup.normal_impulse > 0.0; ++k) {
-      hi = lo, g_hi = g_lo;
-      lo *= 2.0;
-      g_lo = solve(lo);
-    }
-    b = lo;
-    if (g_lo < -touch_tol_) {
-      Illinois br{lo, g_lo, hi, g_hi};
-      double g = g_lo;
-      for (int k = 0; k < 12 && std::abs(g) > touch_tol_; ++k) {
-        b = br.next();
-        g = solve(b);
-        br.update(b, g, /*lo_side=*/g < 0.0);
-      }
-      if (g < -touch_tol_) {  // not converged: the bracket's end above the floor
-        b = br.hi;
-        solve(b);
-      }
-    }
   }
-  // No step may gain mechanical energy (the rest rules rely on it, rest.hpp): the step's end
-  // energy (the free motion keeps the kinetic energy; the COM rises by v_z d) against its start's,
-  // e_start. If the bias would gain, the largest b that does not (bisection; the plain solve never
-  // gains), and step() lifts the rest of the sinking, counted.
+  // No step may gain mechanical energy (the rest rules rely on it, rest.hpp): checked, as an
+  // assertion, against the step's start, e_start (the free motion keeps the kinetic energy; the
+  // COM rises by v_z d). Should rounding break the argument above, the largest b that does not
+  // gain (bisection towards the plain solve), counted as an energy clamp.
   const auto gains = [&] {
     return kinetic_energy(m, s) + m.mass * m.gravity * (s.position.z() + s.velocity.z() * d) > e_start;
   };
@@ -290,6 +397,8 @@ void FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, dou
       (gains() ? bad : ok) = mid;
     }
     solve(ok);
+    ++start_capped;
+    ++a.sup.corrections.energy_clamps;
   }
   a.sup.iterations = sweeps;
 }
@@ -536,6 +645,8 @@ long long FixedStepper::coast(RigidState& s, double& t, double max_time, long lo
 
 // Trials of the shortened step's length (each a whole step) before taking the best one.
 constexpr int kMaxTrials = 12;
+// Halvings of a curved die's step whose curvature impulse was capped (step()).
+constexpr int kMaxHalvings = 4;
 
 int FixedStepper::step(RigidState& s) {
   const DieModel& m = *m_;
@@ -692,6 +803,23 @@ int FixedStepper::step(RigidState& s) {
       }
     }
     ++located;
+  }
+  if (m.curved() && done->capped) {
+    // The curvature impulse could not hold the rims on the floor without gaining energy: the
+    // lowest point's height is far from quadratic over the step (a near-flat coin spinning fast,
+    // its lowest point running round the rim: the slap), or the step's gravity, kicked at its
+    // start, is out of phase with the middle's impulse by g P d / 2 (a disc rolling on its rim
+    // with w^2 a >> g, Euler's disk). Shorter steps, halved (at most kMaxHalvings times) until it
+    // holds; what is still below the floor then is lifted, counted (overlap_fixes).
+    Attempt* buf = done == &b_ ? &lo_ : &b_;
+    double d = dt;
+    for (int k = 0; k < kMaxHalvings && done->capped; ++k) {
+      d *= 0.5;
+      try_step(s0, c, d, *buf);
+      done = buf;
+      dt = d;
+    }
+    ++halved;
   }
   const Attempt& a = *done;
   s = a.s;

@@ -12,9 +12,9 @@
 // Energy: no step gains mechanical energy E = kinetic + m g z_com (the rotation is exact, a step
 // without contact loses m g^2 h^2 / 2, the plastic solve after gravity's kick loses at least
 // (F - m g h)^2 / 2m with F its normal impulse, and no impact gains). `max_energy_gain` records
-// the largest relative gain seen, for the tests. (A curved die's rolling support, which asks the
-// rim for the upward speed that keeps its lowest point on the floor, is capped to keep this too:
-// rim_support.)
+// the largest relative gain seen, for the tests. (A curved die's rim, whose lowest point is not a
+// material point, is held on the floor by an impulse at the step's middle that does no work to
+// second order; checked, and capped if it would gain: rim_support, curvature_support.)
 #pragma once
 
 #include <optional>
@@ -73,6 +73,10 @@ class FixedStepper {
   std::uint64_t located_trials = 0;  // whole trial steps of those shortened steps (the full one not counted)
   double max_energy_gain = 0.0;   // largest relative gain of one impact's kinetic or one step's mechanical energy
   double max_penetration = 0.0;   // curved dice: deepest lowest point below the floor at a step's end (m)
+  std::uint64_t curvature_impulses = 0;  // curved dice: mid-step curvature impulses (rim_support)
+  std::uint64_t curvature_capped = 0;    // ... of them capped to gain no energy
+  std::uint64_t start_capped = 0;        // curved dice: start solves capped to gain no energy (energy_clamps)
+  std::uint64_t halved = 0;              // curved dice: steps halved because the cap left them sinking
 
  private:
   // One trial step of length d from s0 with contact set c; full: the step of length h, whose
@@ -83,13 +87,22 @@ class FixedStepper {
     ImpactResult imp, sup;
     ContactImpulses next;
     double G = 0.0;  // lowest height at the step's end over corners not in c
+    bool capped = false;  // curved: the curvature impulse was capped and left the rims below the floor
   };
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
   // A curved die's support solve for a step of length d (gravity's kick already in s): the plastic
   // solve, rolling resistance, and the touching rims' lowest points held on the floor at the
-  // step's end (contact_stepper.cpp). Leaves rot built for s's free motion.
+  // step's end by the curvature impulse at the step's middle (contact_stepper.cpp). Leaves s and
+  // rot such that rot's free motion of s for d is the step's motion. full: the step of length h
+  // (it decides rims_new_).
   void rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
-                   std::optional<TorqueFreeRotation>& rot);
+                   std::optional<TorqueFreeRotation>& rot, bool full);
+  // Its parts: the solve at the step's start (plastic, biased to hold the rims on the floor), and
+  // the curvature impulse at the step's middle for what the start leaves sinking.
+  void start_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
+                     std::optional<TorqueFreeRotation>& rot);
+  void curvature_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
+                         std::optional<TorqueFreeRotation>& rot);
   // The model of G(d) from the full step's free motion: its lowest new corner at t, raised by what
   // the smaller gravity kick of a step of length t changes, g (h - t) t. Exact for a step without
   // contact (the rotation is the same); with contact the solve absorbs part of the kick.
