@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "ulps.hpp"
+
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -14,12 +16,7 @@
 namespace dicesim {
 namespace {
 
-double ulps(double got, long double exact) {
-  const double e = static_cast<double>(exact);
-  const double a = std::abs(e);
-  const double ulp = std::nextafter(a, std::numeric_limits<double>::infinity()) - a;
-  return static_cast<double>(std::fabs(static_cast<long double>(got) - exact)) / ulp;
-}
+using dicesim::testing::ulps;
 
 TEST(AtanFixed, WithinFourUlpOfLongDouble) {
   std::mt19937_64 gen(5);

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "ulps.hpp"
+
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -15,14 +17,7 @@
 namespace dicesim {
 namespace {
 
-// |got - exact| in units of the last place of the exact value rounded to double.
-double ulps(double got, long double exact) {
-  const double e = static_cast<double>(exact);
-  const double a = std::abs(e);
-  const double ulp = a == 0.0 ? std::numeric_limits<double>::denorm_min()
-                              : std::nextafter(a, std::numeric_limits<double>::infinity()) - a;
-  return static_cast<double>(std::fabs(static_cast<long double>(got) - exact)) / ulp;
-}
+using dicesim::testing::ulps;
 
 TEST(SinCos, WithinOneUlpOfLongDoubleUpToAMillionRadians) {
   std::mt19937_64 gen(1);
