@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "fidelity_test_util.hpp"
 #include "sim/body/body.hpp"
@@ -226,6 +227,22 @@ TEST(CaughtCoin, SameSideProbabilityIsTheTorqueFreeClosedForm) {
   }
 }
 
+// `static` has no motion and its draw no catch time: a caught toss is the face most nearly up as
+// thrown (it used to be `invalid`, every toss, silently). Tilted 30 deg from heads up, and 150.
+TEST(CaughtCoin, StaticGivesTheFaceUpAsThrown) {
+  const std::pair<const char*, int> cases[] = {{"[0, 30, 0]", 1}, {"[0, 150, 0]", 2}};  // heads up, tails up
+  for (const auto& [euler, want] : cases) {
+    const std::string extra = std::string("[throw.orientation]\nkind = \"fixed\"\neuler_deg = ") + euler +
+                              "\n[throw.catch_time]\nmean = 0.6\nsd = 0.08\n[sim]\nend = \"catch\"\nfidelity = \"static\"\n";
+    const DieModel m = coin_model(0.01213, 0.00175, extra.c_str());
+    for (int i = 0; i < 20; ++i) {
+      const TossResult r = toss(m, 7, static_cast<std::uint64_t>(i));
+      ASSERT_EQ(r.status, TossStatus::Settled) << euler;
+      EXPECT_EQ(r.face, want) << euler;
+    }
+  }
+}
+
 // ---- Static ---------------------------------------------------------------------------------------
 
 // `static`, uniform orientation: edge iff the axis is within atan(a0/b0) of horizontal... i.e.
@@ -443,7 +460,9 @@ TEST(CylinderImpulse, LyingFlatDecidesWhateverTheSlidingSpeed) {
   FixedStepper st(m, 5e-4);
   for (int k = 1; k <= 1000; ++k) {
     st.step(s);
-    if (k % 100 == 0) ASSERT_EQ(rim_quasi_static_down(m, s.R, 0.5), 1) << "step " << k;
+    if (k % 100 == 0) {
+      ASSERT_EQ(rim_quasi_static_down(m, s.R, 0.5), 1) << "step " << k;
+    }
   }
   EXPECT_EQ(rest_face_down(m, s, 0.5), 1);
 }
@@ -484,7 +503,9 @@ TEST(CylinderStatic, AgreesWithAManySidedPrism) {
     EXPECT_NEAR(pc[0], heads, 0.01) << region;
     EXPECT_NEAR(pc[1], tails, 0.01) << region;
     EXPECT_NEAR(pc[2], edge, 0.01) << region;
-    if (!region.empty()) EXPECT_GT(cyl.rims.centre.norm(), 1e-4);  // the COM is off the axis
+    if (!region.empty()) {
+      EXPECT_GT(cyl.rims.centre.norm(), 1e-4);  // the COM is off the axis
+    }
   }
 }
 

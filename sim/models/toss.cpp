@@ -139,10 +139,21 @@ TossResult run_catch(const DieModel& m, const RigidState& s, double t) {
   return r;
 }
 
+TossResult caught_as_thrown(const DieModel& m, const RigidState& s) {
+  TossResult r;
+  set_result_face(m, caught_face_index(m, s.R), r);
+  r.status = TossStatus::Settled;
+  return r;
+}
+
 TossResult run(const DieModel& m, const InitialState& init, double tiebreak, TossProbe* probe) {
   const RigidState s = to_body_state(m, init);
   if (!starts_valid(m, s)) return TossResult{};  // status Invalid
-  if (m.catch_end) return run_catch(m, s, init.catch_time);
+  if (m.catch_end) {
+    // `static` has no motion (its draw has no catch time): the face most nearly up as thrown.
+    if (m.fidelity == Fidelity::Static) return caught_as_thrown(m, s);
+    return run_catch(m, s, init.catch_time);
+  }
   switch (m.fidelity) {
     case Fidelity::Paper: return run_paper(m, s, probe);
     case Fidelity::Static: {

@@ -1,0 +1,161 @@
+// Pins every ready scene's exact counts in every fidelity, so that a change of the physics on any
+// of them is a visible decision (README, "Physics changes are visible decisions"). Dice 1-3 and
+// the fair die are pinned at larger counts in test_paper_regression.cpp and
+// test_impulse_regression.cpp; here they add only `static`. Each row: the counts in label order,
+// the bounces, the unresolved and invalid tosses, and the four corrections (energy clamps,
+// unconverged solves, overlap fixes, fallbacks), seed 20261122, 2 threads. The counts are small
+// (a few hundred `impulse` tosses, a few dozen `stepped`) because a pin guards the bits, not the
+// statistics. Regenerate: DICESIM_PRINT_PINS=1 build/tests/dicesim_tests
+// --gtest_filter='ReadyScenes.*' prints every row as it is now; copy them only after checking
+// that the change is intended, and say why in the commit.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "fidelity_test_util.hpp"
+
+namespace {
+
+using namespace dicesim;
+
+struct Pin {
+  const char* scene;
+  Fidelity fidelity;
+  std::uint64_t tosses;
+  std::vector<std::uint64_t> counts;  // label order
+  std::uint64_t bounces;
+  std::uint64_t unresolved, invalid;
+  std::array<std::uint64_t, 4> corrections;
+};
+
+const char* enum_name(Fidelity f) {
+  switch (f) {
+    case Fidelity::Static: return "Static";
+    case Fidelity::Paper: return "Paper";
+    case Fidelity::Impulse: return "Impulse";
+    case Fidelity::Stepped: return "Stepped";
+    case Fidelity::Auto: return "Auto";
+  }
+  return "?";
+}
+
+void check(const Pin& p) {
+  const DieModel m = compile(dicesim::testing::with_fidelity(
+      load_scene(std::string(DICESIM_SOURCE_DIR) + "/" + p.scene), p.fidelity));
+  const RunCounts c = dicesim::testing::run(m, p.tosses, 20261122);
+  const std::array<std::uint64_t, 4> corr = {c.corrections.energy_clamps, c.corrections.pgs_unconverged,
+                                             c.corrections.overlap_fixes, c.corrections.fallbacks};
+  const std::string what = std::string(to_string(p.fidelity)) + " " + p.scene;
+  EXPECT_EQ(c.faces, p.counts) << what;
+  EXPECT_EQ(c.bounces, p.bounces) << what;
+  EXPECT_EQ(c.unresolved, p.unresolved) << what;
+  EXPECT_EQ(c.invalid, p.invalid) << what;
+  EXPECT_EQ(corr, p.corrections) << what;
+  EXPECT_EQ(c.corrections.energy_clamps, 0u) << what;  // the impact law's promise
+  if (::testing::Test::HasFailure() || std::getenv("DICESIM_PRINT_PINS")) {
+    std::string counts;
+    for (std::size_t k = 0; k < c.faces.size(); ++k)
+      counts += (k ? ", " : "") + std::to_string(c.faces[k]);
+    std::printf("      {\"%s\", Fidelity::%s, %llu, {%s}, %llu, %llu, %llu, {%llu, %llu, %llu, %llu}},\n", p.scene,
+                enum_name(p.fidelity), (unsigned long long)p.tosses, counts.c_str(), (unsigned long long)c.bounces,
+                (unsigned long long)c.unresolved, (unsigned long long)c.invalid, (unsigned long long)corr[0],
+                (unsigned long long)corr[1], (unsigned long long)corr[2], (unsigned long long)corr[3]);
+  }
+}
+
+// The polyhedral dice (d4 to d20, prisms, hollow and loaded dice, the seed's variants).
+TEST(ReadyScenes, PolyhedralCountsArePinnedInEveryFidelity) {
+  const Pin pins[] = {
+      {"scenes/paper/die1.toml", Fidelity::Static, 4000, {506, 643, 677, 644, 649, 881}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/paper/die2.toml", Fidelity::Static, 4000, {566, 660, 685, 651, 653, 785}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/paper/die3.toml", Fidelity::Static, 4000, {784, 777, 684, 632, 549, 574}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/fair.toml", Fidelity::Static, 4000, {647, 668, 691, 652, 653, 689}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d4.toml", Fidelity::Static, 4000, {993, 1005, 1025, 977}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d4.toml", Fidelity::Paper, 4000, {1000, 968, 1018, 1014}, 4594, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d4.toml", Fidelity::Impulse, 400, {102, 103, 84, 111}, 7315, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d4.toml", Fidelity::Stepped, 40, {12, 10, 8, 10}, 748, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d6.toml", Fidelity::Static, 4000, {647, 668, 691, 652, 653, 689}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d6.toml", Fidelity::Paper, 4000, {640, 669, 652, 700, 667, 672}, 8737, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d6.toml", Fidelity::Impulse, 400, {61, 75, 67, 69, 69, 59}, 9232, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d6.toml", Fidelity::Stepped, 40, {10, 7, 6, 4, 6, 7}, 812, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d8.toml", Fidelity::Static, 4000, {481, 499, 491, 502, 512, 509, 495, 511}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d8.toml", Fidelity::Paper, 4000, {523, 453, 505, 514, 512, 490, 500, 503}, 5655, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d8.toml", Fidelity::Impulse, 400, {52, 41, 50, 50, 50, 46, 62, 49}, 8210, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d8.toml", Fidelity::Stepped, 40, {4, 8, 6, 5, 6, 4, 5, 2}, 767, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d10.toml", Fidelity::Static, 4000, {386, 383, 393, 405, 392, 419, 410, 406, 403, 403}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d10.toml", Fidelity::Paper, 4000, {380, 384, 399, 421, 413, 398, 416, 377, 425, 387}, 9143, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d10.toml", Fidelity::Impulse, 400, {43, 36, 49, 33, 44, 37, 31, 27, 46, 54}, 10146, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d10.toml", Fidelity::Stepped, 40, {2, 6, 5, 3, 2, 4, 4, 4, 6, 4}, 837, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d12.toml", Fidelity::Static, 4000, {331, 317, 308, 351, 359, 330, 339, 342, 314, 339, 331, 339}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d12.toml", Fidelity::Paper, 4000, {313, 332, 344, 348, 324, 333, 339, 355, 334, 311, 317, 350}, 17120, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d12.toml", Fidelity::Impulse, 400, {39, 42, 31, 30, 35, 34, 35, 32, 35, 31, 32, 24}, 12119, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d12.toml", Fidelity::Stepped, 40, {6, 2, 4, 3, 2, 5, 2, 4, 4, 3, 0, 5}, 1136, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d20.toml", Fidelity::Static, 4000, {220, 184, 207, 191, 178, 203, 198, 205, 184, 192, 206, 209, 191, 211, 196, 210, 190, 207, 204, 214}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d20.toml", Fidelity::Paper, 4000, {194, 194, 204, 192, 200, 200, 207, 185, 217, 188, 210, 204, 205, 217, 184, 212, 193, 200, 186, 208}, 10679, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d20.toml", Fidelity::Impulse, 400, {17, 17, 17, 20, 23, 23, 23, 24, 23, 16, 19, 19, 31, 13, 19, 12, 23, 25, 16, 20}, 9393, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/d20.toml", Fidelity::Stepped, 40, {0, 2, 3, 2, 2, 2, 3, 3, 1, 3, 4, 2, 1, 1, 0, 2, 2, 2, 2, 3}, 889, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/loaded-d20.toml", Fidelity::Static, 4000, {263, 253, 257, 217, 193, 244, 208, 226, 206, 152, 238, 180, 181, 193, 158, 182, 149, 167, 152, 181}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/loaded-d20.toml", Fidelity::Paper, 4000, {182, 186, 216, 205, 195, 210, 199, 189, 203, 237, 197, 215, 209, 208, 177, 216, 197, 207, 175, 177}, 11546, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/loaded-d20.toml", Fidelity::Impulse, 400, {31, 38, 36, 18, 31, 28, 23, 22, 17, 15, 23, 22, 16, 11, 11, 10, 15, 13, 11, 9}, 10445, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/loaded-d20.toml", Fidelity::Stepped, 40, {4, 2, 2, 5, 2, 4, 6, 1, 0, 0, 2, 0, 1, 3, 1, 1, 3, 1, 1, 1}, 948, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/hollow-d6.toml", Fidelity::Static, 4000, {666, 664, 691, 653, 650, 676}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/hollow-d6.toml", Fidelity::Paper, 4000, {677, 661, 663, 676, 654, 669}, 6922, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/hollow-d6.toml", Fidelity::Impulse, 400, {74, 64, 68, 61, 70, 63}, 9265, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/hollow-d6.toml", Fidelity::Stepped, 40, {5, 3, 6, 12, 9, 5}, 869, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/prism3.toml", Fidelity::Static, 4000, {1313, 1306, 1298, 57, 26}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/prism3.toml", Fidelity::Paper, 4000, {946, 956, 1001, 546, 551}, 5332, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/prism3.toml", Fidelity::Impulse, 400, {139, 132, 129, 0, 0}, 8174, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/prism3.toml", Fidelity::Stepped, 40, {14, 13, 13, 0, 0}, 543, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/steel-cuboid.toml", Fidelity::Static, 4000, {1152, 412, 428, 398, 416, 1194}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/steel-cuboid.toml", Fidelity::Paper, 4000, {859, 565, 532, 577, 604, 863}, 8061, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/steel-cuboid.toml", Fidelity::Impulse, 400, {160, 13, 10, 10, 5, 202}, 8180, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/steel-cuboid.toml", Fidelity::Stepped, 40, {23, 2, 1, 1, 0, 13}, 800, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/plastic.toml", Fidelity::Static, 4000, {647, 668, 691, 652, 653, 689}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/plastic.toml", Fidelity::Paper, 4000, {673, 644, 648, 680, 675, 680}, 6679, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/plastic.toml", Fidelity::Impulse, 400, {67, 68, 73, 71, 66, 55}, 8494, 0, 0, {0, 0, 0, 0}},
+      {"scenes/dice/plastic.toml", Fidelity::Stepped, 40, {11, 7, 3, 5, 8, 6}, 840, 0, 0, {0, 0, 0, 0}},
+      {"scenes/paper/variants/die1-seed-euler-uniform.toml", Fidelity::Static, 4000, {969, 440, 487, 450, 426, 1228}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/paper/variants/die1-seed-euler-uniform.toml", Fidelity::Paper, 4000, {631, 678, 662, 633, 586, 810}, 6539, 0, 0, {0, 0, 0, 0}},
+      {"scenes/paper/variants/die1-seed-euler-uniform.toml", Fidelity::Impulse, 400, {37, 63, 82, 51, 49, 118}, 8990, 0, 0, {0, 0, 0, 0}},
+      {"scenes/paper/variants/die1-seed-euler-uniform.toml", Fidelity::Stepped, 40, {4, 4, 9, 6, 9, 8}, 778, 0, 0, {0, 0, 0, 0}},
+      {"scenes/paper/variants/die1-seed-swapped-restitution.toml", Fidelity::Static, 4000, {506, 643, 677, 644, 649, 881}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/paper/variants/die1-seed-swapped-restitution.toml", Fidelity::Paper, 4000, {585, 633, 646, 698, 701, 737}, 6922, 0, 0, {0, 0, 0, 0}},
+      {"scenes/paper/variants/die1-seed-swapped-restitution.toml", Fidelity::Impulse, 400, {45, 59, 64, 54, 67, 111}, 8841, 0, 0, {0, 0, 0, 0}},
+      {"scenes/paper/variants/die1-seed-swapped-restitution.toml", Fidelity::Stepped, 40, {5, 8, 4, 7, 8, 8}, 835, 0, 0, {0, 0, 0, 0}},
+      {"scenes/paper/variants/die1-seed-variance-reading.toml", Fidelity::Static, 4000, {498, 635, 667, 635, 641, 873}, 0, 0, 51, {0, 0, 0, 0}},
+      {"scenes/paper/variants/die1-seed-variance-reading.toml", Fidelity::Paper, 4000, {513, 656, 687, 687, 666, 740}, 6615, 0, 51, {0, 0, 0, 0}},
+      {"scenes/paper/variants/die1-seed-variance-reading.toml", Fidelity::Impulse, 400, {32, 58, 66, 52, 61, 129}, 8844, 0, 2, {0, 0, 0, 0}},
+      {"scenes/paper/variants/die1-seed-variance-reading.toml", Fidelity::Stepped, 40, {1, 9, 6, 7, 3, 14}, 843, 0, 0, {0, 0, 0, 0}},
+  };
+  for (const Pin& p : pins) check(p);
+}
+
+// The coins: the rim's curved contact has its own support (contact_stepper.cpp rim_support).
+TEST(ReadyScenes, CoinCountsArePinnedInEveryFidelity) {
+  const Pin pins[] = {
+      {"scenes/coins/quarter.toml", Fidelity::Static, 4000, {235, 1852, 1913}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/quarter.toml", Fidelity::Paper, 4000, {1892, 1025, 1083}, 8296, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/quarter.toml", Fidelity::Impulse, 400, {7, 191, 202}, 4462, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/quarter.toml", Fidelity::Stepped, 40, {0, 17, 23}, 359, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/quarter-table.toml", Fidelity::Static, 4000, {0, 4000, 0}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/quarter-table.toml", Fidelity::Paper, 4000, {1197, 1649, 1154}, 7575, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/quarter-table.toml", Fidelity::Impulse, 400, {4, 212, 184}, 4981, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/quarter-table.toml", Fidelity::Stepped, 40, {2, 16, 22}, 301, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/three-sided-coin.toml", Fidelity::Static, 4000, {1370, 1288, 1342}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/three-sided-coin.toml", Fidelity::Paper, 4000, {1366, 1311, 1323}, 11430, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/three-sided-coin.toml", Fidelity::Impulse, 400, {127, 136, 137}, 5033, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/three-sided-coin.toml", Fidelity::Stepped, 40, {12, 21, 7}, 427, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/quarter-caught.toml", Fidelity::Static, 4000, {0, 4000, 0}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/quarter-caught.toml", Fidelity::Paper, 4000, {0, 2019, 1981}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/quarter-caught.toml", Fidelity::Impulse, 400, {0, 201, 199}, 0, 0, 0, {0, 0, 0, 0}},
+      {"scenes/coins/quarter-caught.toml", Fidelity::Stepped, 40, {0, 23, 17}, 0, 0, 0, {0, 0, 0, 0}},
+  };
+  for (const Pin& p : pins) check(p);
+}
+
+}  // namespace
