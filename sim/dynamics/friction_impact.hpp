@@ -79,6 +79,9 @@ struct ContactPoints {
   // I_w^-1 (r x e_k), and the point's own velocity change along z (W's third column). The
   // sweeps apply their impulses through these (no cross products or 3x3 products per update).
   Vec3 ax[kMaxContacts], ay[kMaxContacts], az[kMaxContacts], wz[kMaxContacts];
+  // Whether inv_wtt, ax, ay, az and wz are set: one point's exact solve needs none of them, so
+  // they are filled only when its solve falls back to the sweeps (set_up_geometry's caller).
+  bool sweep_terms = false;
 };
 
 // A solve's set-up for one orientation and contact set: the world inertia, its inverse and the
