@@ -243,7 +243,8 @@ bool one_corner_sliding_reference(const Mat3& W, const Vec3& u, double mu, Eigen
 // theta' > -1/4, Newton's step where Halley's correction factor leaves [2/3, 2]. From the sliding
 // direction; the root is verified (den > 0, the final slip opposite d and perpendicular to it to
 // 1e-13 of the speeds), else false.
-bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d, Vec3& P) {
+bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d, Vec3& P,
+                               int* iterations) {
   const double m = -u.z();
   const double a = W(2, 2), bx = W(0, 2), by = W(1, 2);
   const double A00 = W(0, 0), A01 = W(0, 1), A11 = W(1, 1);
@@ -260,6 +261,7 @@ bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::V
   Eigen::Vector2d d_prev = d;
   double measure_prev = 0.0, step_prev = 0.0;
   for (int it = 0; it < 40; ++it) {
+    if (iterations) *iterations = it + 1;
     const double dx = d.x(), dy = d.y();  // d' = (-dy, dx)
     const double den = a + mu * (bx * dx + by * dy);
     if (!(den > 0.0)) return false;

@@ -120,10 +120,12 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
 // The one-corner plastic sliding impulse P = lambda (mu d, 1) (d a unit friction direction):
 // zero final normal velocity u + W P, final slip anti-parallel to d. W the point's compliance, u
 // its velocity before (u_z < 0), d0 the starting direction (opposite the slip before). The
-// impact law uses the Newton solve and falls back to the reference (a fixed point on d, then a
+// impact law uses the Newton solve (Halley's third-order step near the root) and falls back to the reference (a fixed point on d, then a
 // root search in its angle) where Newton's root does not verify; both exposed for the tests
 // that compare them. False: no root (Newton: none verified; reference: a jam).
-bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d0, Vec3& P);
+// (iterations: set to the number of residual evaluations before the verification.)
+bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d0, Vec3& P,
+                               int* iterations = nullptr);
 // (by_angle: set when the reference needed its angle search.)
 bool one_corner_sliding_reference(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d0, Vec3& P,
                                   bool* by_angle = nullptr);
