@@ -269,7 +269,9 @@ TEST(FrictionImpact, EnergyNeverRisesForOneToFourContacts) {
             // e = 1 and mu = 0 at one point: the Newton impulse, elastic. (Several points may lose
             // energy even then: a restitution impulse that tips a neighbour into the floor is
             // followed by a plastic impact of that neighbour.)
-            if (e == 1.0 && mu == 0.0 && k == 1) EXPECT_NEAR(kinetic_energy(m, l.s), e0, 1e-12 * e0);
+            if (e == 1.0 && mu == 0.0 && k == 1) {
+              EXPECT_NEAR(kinetic_energy(m, l.s), e0, 1e-12 * e0);
+            }
           }
       }
   EXPECT_EQ(gained, 0) << "of " << impacts;
@@ -338,7 +340,9 @@ TEST(FrictionImpact, CoulombAtEveryContactOfMultiPointImpacts) {
             const Vec3 u = corner_velocity(m, l.s, l.c.vertex[i]);
             EXPECT_GE(u.z(), -1e-9 * scale);
             if (restitution) continue;
-            if (p.z() > 1e-9 * m.mass * scale) EXPECT_LE(std::abs(u.z()), 1e-9 * scale);  // loaded: stays on the floor
+            if (p.z() > 1e-9 * m.mass * scale) {
+              EXPECT_LE(std::abs(u.z()), 1e-9 * scale);  // loaded: stays on the floor
+            }
             const double slip = std::hypot(u.x(), u.y());
             if (slip > 1e-6 * scale && p.z() > 1e-6 * m.mass * scale) {
               ++slipping;
