@@ -226,20 +226,30 @@ bool one_corner_sliding_reference(const Mat3& W, const Vec3& u, double mu, Eigen
 // (its tangential-normal column) and a = W_nn, the normal impulse is lambda = m / den,
 // den = a + mu b.d, and the final slip s = S / den, S = den u_t + m (b + mu A d) (the quartic in
 // tan(phi / 2) of the closed form is S x d = 0; but its roots include the invalid ones, slip along
-// the friction). The residual taken is q = tan(theta / 2), theta the angle from d to -S:
-// q = (S x d) / (|S| - S.d), zero only where the slip opposes the friction (theta = 0), infinite
-// at the invalid roots (theta = pi). q' = (1 + q^2) theta' / 2 with theta' = (S x S') / |S|^2 - 1,
-// S' = mu (b.d') u_t + m mu A d', d' = perp(d). Newton in phi, each step taken as
-// d <- (d + delta d') / sqrt(1 + delta^2) (the angle atan(delta): delta to third order, so the
-// convergence stays quadratic, and no sin/cos), delta capped at 1 (45 degrees). The fixed point
-// d <- -S / |S| is the step delta = theta: Newton's is theta / (1 - arg'(S)), exact where the map
-// is linear. From the sliding direction, as the fixed point started; the root is then verified
-// (den > 0, the final slip opposite d and perpendicular to it to 1e-13 of the speeds), else false.
-bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d, Vec3& P) {
+// the friction). The residual is theta, the angle from d to -S: zero only where the slip opposes
+// the friction, +-pi at the invalid roots. theta' = (S x S') / |S|^2 - 1, S' = mu (b.d') u_t +
+// m mu A d', d' = perp(d), and since d'' = -d, S'' = a u_t + m b - S (so theta'' is cheap too).
+// Near the root (|theta| < 0.1, S.d < 0: almost every iteration) Halley's step on
+// r = tan(theta) = (S x d) / (-S.d), which is rational in S, S', S'' and d (1 + r^2 = |S|^2 /
+// (S.d)^2): r' = g / (S.d)^2 with g = S x S' - |S|^2, r'' = (2 r g^2 + h) / ((S.d)^2 |S|^2) with
+// h = (S x S'') |S|^2 - 2 (S x S') (S.S'), and the step
+//   delta = -2 r r' / (2 r'^2 - r r'') = 2 (S x d) g |S|^2 / (2 g^2 (S.d) + (S x d) h):
+// one division, no arc tangent, cubic convergence (single4's Newton on theta needed 3.2
+// iterations and an arc-tangent series per iteration). Far from it, Newton on theta, with
+// theta = 2 atan(q), q = tan(theta / 2) = (S x d) / (|S| - S.d), finite except at theta = pi.
+// Each step is taken as d <- (d + t d') / sqrt(1 + t^2), t = tan(delta) (no sin/cos), |delta|
+// <= 1 (or 0.1 for Halley's). Safeguards: backtracking when |theta| does not fall (measured by
+// sin^2 theta, extended past pi / 2 to stay monotone), the fixed point's step d <- -S / |S| where
+// theta' > -1/4, Newton's step where Halley's correction factor leaves [2/3, 2]. From the sliding
+// direction; the root is verified (den > 0, the final slip opposite d and perpendicular to it to
+// 1e-13 of the speeds), else false.
+bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d, Vec3& P,
+                               int* iterations) {
   const double m = -u.z();
   const double a = W(2, 2), bx = W(0, 2), by = W(1, 2);
   const double A00 = W(0, 0), A01 = W(0, 1), A11 = W(1, 1);
   const double ux = u.x(), uy = u.y();
+  const double Kx = a * ux + m * bx, Ky = a * uy + m * by;  // S'' + S
   // d turned by atan(t): (d + t d') / sqrt(1 + t^2); for small t the inverse root by its series
   // (to 3e-17: the latency of a square root and a division saved in the common last steps).
   const auto turn = [](const Eigen::Vector2d& v, double t) {
@@ -249,8 +259,9 @@ bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::V
   };
   bool converged = false;
   Eigen::Vector2d d_prev = d;
-  double theta_prev = 0.0, step_prev = 0.0;
+  double measure_prev = 0.0, step_prev = 0.0;
   for (int it = 0; it < 40; ++it) {
+    if (iterations) *iterations = it + 1;
     const double dx = d.x(), dy = d.y();  // d' = (-dy, dx)
     const double den = a + mu * (bx * dx + by * dy);
     if (!(den > 0.0)) return false;
@@ -260,24 +271,21 @@ bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::V
     const double Spx = mu * (bdp * ux + m * (A01 * dx - A00 * dy));
     const double Spy = mu * (bdp * uy + m * (A11 * dx - A01 * dy));
     const double S2 = Sx * Sx + Sy * Sy, cross = Sx * dy - Sy * dx, dot = Sx * dx + Sy * dy;
-    const double g = (Sx * Spy - Sy * Spx) - S2;  // theta' S2
-    double theta, step;
-    if (dot < 0.0 && cross * cross < 1e-2 * dot * dot) {
-      // Near the root (|theta| < 0.1, the common case): theta = atan(cross / -dot) by its series
-      // (to 1e-14 relative), and the Newton step, with one division between them.
-      const double inv = 1.0 / (dot * g);
-      const double r = -cross * g * inv, r2 = r * r;
-      theta = r * (1.0 - r2 * (1.0 / 3.0 - r2 * (1.0 / 5.0 - r2 * (1.0 / 7.0 - r2 * (1.0 / 9.0 - r2 * (1.0 / 11.0))))));
-      step = -theta * S2 * dot * inv;
+    const double c = Sx * Spy - Sy * Spx;
+    const double g = c - S2;  // theta' S2
+    const bool near = dot < 0.0 && cross * cross < 1e-2 * dot * dot;
+    double measure, theta = 0.0;  // measure: increasing in |theta| on [0, pi]
+    if (near) {
+      measure = cross * cross / S2;  // sin^2 theta (off the step's chain)
     } else {
       // (sqrt(x^2 + y^2), not hypot: S is a speed times a compliance, far from overflow.)
-      const double Sn = std::sqrt(S2);
-      const double q = cross / (Sn - dot);  // tan(theta / 2): finite except at theta = pi
+      const double q = cross / (std::sqrt(S2) - dot);  // tan(theta / 2): finite except at theta = pi
       const double q2 = q * q;
       theta = q2 < 1e-2 ? 2.0 * q * (1.0 - q2 * (1.0 / 3.0 - q2 * (0.2 - q2 * (1.0 / 7.0)))) : 2.0 * atan_fixed(q);  // not libm: the same bits on every CPU (sim/atan.hpp)
-      step = -theta * S2 / g;
+      const double sn = 2.0 * q / (1.0 + q2), sn2 = sn * sn;
+      measure = q2 <= 1.0 ? sn2 : 2.0 - sn2;
     }
-    if (it > 0 && !(std::abs(theta) < std::abs(theta_prev))) {
+    if (it > 0 && !(measure < measure_prev)) {
       // No decrease: back to the last iterate with half the step (a safeguard; rare).
       step_prev *= 0.5;
       if (!(std::abs(step_prev) > 1e-9)) return false;
@@ -285,34 +293,69 @@ bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::V
       continue;
     }
     d_prev = d;
-    theta_prev = theta;
+    measure_prev = measure;
     if (!(g < -0.25 * S2)) {
       // theta nearly flat or rising (theta' >= -1/4): Newton's step is no guide. The fixed
       // point's instead, d <- -S / |S| (the turn by theta), which the next iterate must improve on.
-      step_prev = std::abs(theta) >= 0.25 * M_PI ? (theta > 0.0 ? 1.0 : -1.0) : std::tan(theta);
+      if (near) theta = -cross / dot;  // tan theta, as the turn wants it (|theta| < 0.1)
+      else theta = std::abs(theta) >= 0.25 * M_PI ? (theta > 0.0 ? 1.0 : -1.0) : std::tan(theta);
+      step_prev = theta;
       d = Eigen::Vector2d(-Sx, -Sy) * (1.0 / std::sqrt(S2));
       continue;
     }
-    if (!std::isfinite(step)) return false;
-    step = std::clamp(step, -1.0, 1.0);
-    step_prev = step;
-    d = turn(d, step);
-    // The next step would be ~ step^2 theta'' / theta': below rounding.
-    if (std::abs(step) <= 1e-9) {
+    // theta'' S2^2 (S'' = K - S, so S x S'' = S x K).
+    const double h = (Sx * Ky - Sy * Kx) * S2 - 2.0 * c * (Sx * Spx + Sy * Spy);
+    double t;
+    bool done;
+    if (near) {
+      const double hd = 2.0 * g * g * dot, corr = cross * h;
+      double delta;
+      if (std::abs(corr) <= 0.5 * std::abs(hd)) {
+        delta = 2.0 * cross * g * S2 / (hd + corr);  // Halley
+        // Cubic convergence (measured on Die 1: the next step ~0.4-0.7 times this one's cube):
+        // after a step this small the error is below rounding, so it is not evaluated again.
+        done = std::abs(delta) <= 1e-5;
+      } else {
+        delta = cross * dot / g;  // Newton on tan(theta)
+        done = std::abs(delta) <= 1e-9;
+      }
+      delta = std::clamp(delta, -0.1, 0.1);
+      t = delta * (1.0 + delta * delta * (1.0 / 3.0));  // tan(delta) to delta^5
+    } else {
+      const double hd = 2.0 * g * g, corr = -theta * h;
+      double step;
+      if (std::abs(corr) <= 0.5 * hd) {
+        step = -2.0 * theta * g * S2 / (hd + corr);  // Halley on theta
+        done = std::abs(step) <= 1e-5;
+      } else {
+        step = -theta * S2 / g;  // Newton
+        done = std::abs(step) <= 1e-9;
+      }
+      if (!std::isfinite(step)) return false;
+      t = std::clamp(step, -1.0, 1.0);
+      if (std::abs(t) < 0.1) t *= 1.0 + t * t * (1.0 / 3.0);  // tan(step) to step^5
+
+    }
+    if (!std::isfinite(t)) return false;
+    step_prev = t;
+    d = turn(d, t);
+    if (done) {
       converged = true;
       break;
     }
   }
+
   if (!converged) return false;
   const Vec3 dir(mu * d.x(), mu * d.y(), 1.0);
   const Vec3 Wd = W * dir;
   if (!(Wd.z() > 0.0)) return false;
   const double lambda = m / Wd.z();
   const double sx = ux + lambda * Wd.x(), sy = uy + lambda * Wd.y();
-  // (sqrt(x^2 + y^2) rather than hypot: speeds of m/s scale cannot overflow or underflow.)
-  const double scale = std::sqrt(u.squaredNorm()) + lambda * std::sqrt(Wd.squaredNorm());
-  if (!(sx * d.x() + sy * d.y() < 0.0)) return false;                   // the slip opposes the friction
-  if (!(std::abs(sx * d.y() - sy * d.x()) <= 1e-13 * scale)) return false;  // and is anti-parallel to it
+  if (!(sx * d.x() + sy * d.y() < 0.0)) return false;  // the slip opposes the friction
+  // And is anti-parallel to it, to 1e-13 of the speeds |u| + lambda |Wd|; compared in squares
+  // against |u|^2 + lambda^2 |Wd|^2 (no square roots; at most sqrt(2) stricter).
+  const double cr = sx * d.y() - sy * d.x();
+  if (!(cr * cr <= 1e-26 * (u.squaredNorm() + lambda * lambda * Wd.squaredNorm()))) return false;
   P = lambda * dir;
   return true;
 }
@@ -762,15 +805,17 @@ bool solve_sliding(const Body& b, const Points& pts, double speed, double lever,
         const int j = idx[a];
         Vec3 u = u0[j];
         for (int c = 0; c < k; ++c) u += lambda[idx[c]] * Rji[a][c];
-        const Eigen::Vector2d t(u.x(), u.y());
-        const double tn = t.norm();
-        if (!(tn > slip_floor)) return false;  // sticks: not this case
-        next[j] = t / tn;
+        const double tn2 = u.x() * u.x() + u.y() * u.y();
+        if (!(tn2 > slip_floor * slip_floor)) return false;  // sticks: not this case
+        const double inv_tn = 1.0 / std::sqrt(tn2);
+        next[j] = Eigen::Vector2d(u.x() * inv_tn, u.y() * inv_tn);
         const Eigen::Vector2d dd = -pts.mu[j] * lambda[j] * (next[j] - d[j]);
         move_v += Vec3(dd.x(), dd.y(), 0.0) * b.inv_mass;
         move_w += dd.x() * pts.ax[j] + dd.y() * pts.ay[j];
       }
-      if (move_v.norm() + lever * move_w.norm() <= tol) {
+      // |move_v| + lever |move_w| <= tol, tested in squares (no square roots on the iteration's
+      // chain): 2 (|move_v|^2 + lever^2 |move_w|^2) <= tol^2 implies it (at most sqrt(2) stricter).
+      if (2.0 * (move_v.squaredNorm() + lever * lever * move_w.squaredNorm()) <= tol * tol) {
         converged = true;
       } else {
         // Anderson acceleration (depth 1) of the fixed point: the map is nearly linear, so the
@@ -790,10 +835,10 @@ bool solve_sliding(const Body& b, const Points& pts, double speed, double lever,
         const double gamma = it > 0 && dd2 > 0.0 ? rr / dd2 : 0.0;
         for (int a = 0; a < k; ++a) {
           const int j = idx[a];
-          Eigen::Vector2d x = next[j] - gamma * (next[j] - prev_next[j]);
-          const double xn = x.norm();
+          const Eigen::Vector2d x = next[j] - gamma * (next[j] - prev_next[j]);
+          const double xn2 = x.squaredNorm();
           prev_next[j] = next[j];
-          d[j] = xn > 0.0 && std::isfinite(xn) ? Eigen::Vector2d(x / xn) : next[j];
+          d[j] = xn2 > 0.0 && std::isfinite(xn2) ? Eigen::Vector2d(x * (1.0 / std::sqrt(xn2))) : next[j];
         }
       }
     }
@@ -1161,6 +1206,20 @@ SweepResult solve_friction(const Body& b, const Points& pts, const double radius
   return {kMaxSweeps + nr.iterations, false};
 }
 
+// The sweeps' and the direct multi-point solves' terms of the set-up (ContactPoints::sweep_terms).
+void set_up_sweep_terms(ContactGeometry& geo) {
+  Points& pts = geo.pts;
+  if (pts.sweep_terms) return;
+  for (int i = 0; i < pts.n; ++i) {
+    pts.inv_wtt[i] = pts.wtt[i].inverse();
+    const Vec3& r = pts.r[i];
+    pts.ax[i] = geo.inv_inertia * Vec3(0.0, r.z(), -r.y());
+    pts.ay[i] = geo.inv_inertia * Vec3(-r.z(), 0.0, r.x());
+    pts.az[i] = geo.inv_inertia * Vec3(r.y(), -r.x(), 0.0);
+  }
+  pts.sweep_terms = true;
+}
+
 // The part of a solve's set-up that depends only on the orientation R and the contact set.
 void set_up_geometry(const DieModel& m, const Body& b, const Mat3& R, const ContactSet& c, ContactGeometry& geo) {
   geo.Iw = world_inertia(m, R);
@@ -1192,14 +1251,11 @@ void set_up_geometry(const DieModel& m, const Body& b, const Mat3& R, const Cont
     if (i == 0) pts.W0 = W;
     pts.inv_wnn[i] = 1.0 / W(2, 2);
     pts.wtt[i] = W.topLeftCorner<2, 2>();
-    pts.inv_wtt[i] = pts.wtt[i].inverse();
-    const Vec3& r = pts.r[i];
-    pts.ax[i] = b.inv_inertia * Vec3(0.0, r.z(), -r.y());
-    pts.ay[i] = b.inv_inertia * Vec3(-r.z(), 0.0, r.x());
-    pts.az[i] = b.inv_inertia * Vec3(r.y(), -r.x(), 0.0);
     pts.wz[i] = W.col(2);
   }
+  pts.sweep_terms = false;
   if (c.n == 1) pts.W0_inverse = pts.W0.inverse();
+  else set_up_sweep_terms(geo);  // (one point: only if its exact solve falls back to the sweeps)
   geo.valid = true;
 }
 
@@ -1282,6 +1338,7 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
     if (!solved) solved = solve_sticking(b, Iw, pts, lever, pn, pt);
   }
   if (!solved) {
+    set_up_sweep_terms(geo);
     for (int i = 0; i < c.n; ++i) {
       pn[i] = 0.0;
       pt[i].setZero();
@@ -1366,6 +1423,7 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
     return false;
   };
   for (int pass = 0; pass < 2 && approaching(); ++pass) {
+    set_up_sweep_terms(geo);
     Points p2 = pts;
     if (pass == 1) {
       ++res.corrections.fallbacks;

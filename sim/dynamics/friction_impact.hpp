@@ -79,6 +79,9 @@ struct ContactPoints {
   // I_w^-1 (r x e_k), and the point's own velocity change along z (W's third column). The
   // sweeps apply their impulses through these (no cross products or 3x3 products per update).
   Vec3 ax[kMaxContacts], ay[kMaxContacts], az[kMaxContacts], wz[kMaxContacts];
+  // Whether inv_wtt, ax, ay, az and wz are set: one point's exact solve needs none of them, so
+  // they are filled only when its solve falls back to the sweeps (set_up_geometry's caller).
+  bool sweep_terms = false;
 };
 
 // A solve's set-up for one orientation and contact set: the world inertia, its inverse and the
@@ -117,10 +120,12 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
 // The one-corner plastic sliding impulse P = lambda (mu d, 1) (d a unit friction direction):
 // zero final normal velocity u + W P, final slip anti-parallel to d. W the point's compliance, u
 // its velocity before (u_z < 0), d0 the starting direction (opposite the slip before). The
-// impact law uses the Newton solve and falls back to the reference (a fixed point on d, then a
+// impact law uses the Newton solve (Halley's third-order step near the root) and falls back to the reference (a fixed point on d, then a
 // root search in its angle) where Newton's root does not verify; both exposed for the tests
 // that compare them. False: no root (Newton: none verified; reference: a jam).
-bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d0, Vec3& P);
+// (iterations: set to the number of residual evaluations before the verification.)
+bool one_corner_sliding_newton(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d0, Vec3& P,
+                               int* iterations = nullptr);
 // (by_angle: set when the reference needed its angle search.)
 bool one_corner_sliding_reference(const Mat3& W, const Vec3& u, double mu, Eigen::Vector2d d0, Vec3& P,
                                   bool* by_angle = nullptr);
