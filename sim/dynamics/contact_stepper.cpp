@@ -879,6 +879,20 @@ int FixedStepper::step(RigidState& s) {
     ++located;
   };
   locate();
+  if (slap_rims_ != 0 && done->capped) {
+    // A slap's step whose near half the capped curvature impulse leaves sinking: halved as a
+    // plain step would be (below), still a slap's (its end then before the far half's arrival).
+    Attempt* buf = done == &b_ ? &lo_ : &b_;
+    double d = dt;
+    for (int k = 0; k < kMaxHalvings && done->capped; ++k) {
+      d *= 0.5;
+      try_step(s0, c, d, *buf);
+      done = buf;
+      dt = d;
+      buf = buf == &b_ ? &lo_ : &b_;
+    }
+    ++halved;
+  }
   if (slap_rims_ != 0 && done->s.position.z() + rim_lowest(m, done->s.R) < -touch_tol_) {
     slap_rims_ = 0;
     try_step(s0, c, h_, a_, /*full=*/true);
