@@ -103,6 +103,13 @@ nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
           {"impacts_per_toss", static_cast<double>(one.bounces) / static_cast<double>(n)},
           {"search_steps_per_flight", probe.flights ? static_cast<double>(probe.search_iterations) / probe.flights : 0.0},
           {"fixed_steps_per_toss", static_cast<double>(probe.steps) / np},
+          // The stepper's adaptive steps (not corrections): shortened to a new contact's instant,
+          // and, for a curved die, halved for a capped curvature impulse, its capped impulses, and
+          // shortened to a slapping face's arrival.
+          {"located_steps_per_toss", static_cast<double>(probe.located_steps) / np},
+          {"halved_steps_per_toss", static_cast<double>(probe.halved) / np},
+          {"curvature_capped_per_toss", static_cast<double>(probe.curvature_capped) / np},
+          {"slaps_per_toss", static_cast<double>(probe.slaps) / np},
           {"timed_tosses", n_probe},
           {"timed_tosses_per_s", np / probe_total},
           {"phases", phases},
@@ -128,8 +135,12 @@ void print_text(const nlohmann::json& r) {
   std::printf("  identical counts    %s\n", r["identical_counts"].get<bool>() ? "yes" : "NO (a bug: please report)");
   std::printf("  impacts per toss    %.3f\n  search steps/flight %.2f\n", r["impacts_per_toss"].get<double>(),
               r["search_steps_per_flight"].get<double>());
-  if (r["fixed_steps_per_toss"].get<double>() > 0)
+  if (r["fixed_steps_per_toss"].get<double>() > 0) {
     std::printf("  fixed steps/toss    %.1f\n", r["fixed_steps_per_toss"].get<double>());
+    std::printf("    located %.3f  halved %.3f  capped curvature %.3f  slaps %.3f (per toss)\n",
+                r["located_steps_per_toss"].get<double>(), r["halved_steps_per_toss"].get<double>(),
+                r["curvature_capped_per_toss"].get<double>(), r["slaps_per_toss"].get<double>());
+  }
   std::printf("  time split (one thread, each phase timed: %.0f tosses/s while timed)\n",
               r["timed_tosses_per_s"].get<double>());
   for (int k = 0; k < kPhaseCount; ++k) {
@@ -223,7 +234,8 @@ void register_bench(CLI::App& app, int& exit_code) {
   cmd->add_flag("--json", args->json,
                 "One JSON object on stdout: scene, shape, and per fidelity (\"fidelities\": [...]) tosses_per_s_1_thread,\n"
                 "tosses_per_s (all threads), scaling_efficiency, identical_counts, impacts_per_toss,\n"
-                "search_steps_per_flight, fixed_steps_per_toss, phases {name: {share, per_toss, us_each}},\n"
+                "search_steps_per_flight, fixed_steps_per_toss, located_steps_per_toss,\n"
+                "halved_steps_per_toss, curvature_capped_per_toss, slaps_per_toss, phases {name: {share, per_toss, us_each}},\n"
                 "other_share; with one fidelity its fields also at the top level");
   cmd->callback([args, &exit_code] { exit_code = run_bench(*args); });
 }

@@ -55,9 +55,41 @@ double FixedStepper::lowest_new(const ContactSet& c, const Vec3& p, const Vec3& 
   // out of the contact set is above the tolerance here too).
   if (m_->curved()) {  // a cylinder's rim points need the whole orientation
     const Mat3 R = t == 0.0 ? rot_start_ : rot.orientation(t);
-    return p.z() + v.z() * t + (rims_new_ ? rim_lowest(*m_, R) : rim_lowest_excluding(*m_, R, c));
+    return p.z() + v.z() * t + curved_low(c, R);
   }
   return lowest_flat(c, p, v, t == 0.0 ? Vec3(rot_start_.row(2).transpose()) : rot.bottom_row(t), t);
+}
+
+double FixedStepper::curved_low(const ContactSet& c, const Mat3& R) const {
+  if (rims_new_) return rim_lowest(*m_, R);
+  double low = rim_lowest_excluding(*m_, R, c);
+  if (slap_rims_ != 0) {
+    const Vec3 z_row = R.row(2).transpose();
+    for (int r = 0; r < 2; ++r)
+      if (slap_rims_ & (1 << r)) low = std::min(low, slap_low(z_row, r));
+  }
+  return low;
+}
+
+double FixedStepper::slap_low(const Vec3& z_row, int rim) const {
+  // A rim point at body angle phi (from perp towards axis x perp) is at height
+  // z_row.centre_rim + radius (a cos phi + b sin phi) about the COM, a and b the world heights of
+  // the two basis directions; the lowest point of the whole circle is at -(a, b). The far half,
+  // (cos phi, sin phi).u0 <= 0: that point if it lies there, else the lower end of the half,
+  // +-(u0 turned by 90 deg), at radius (a, b).w, w = (-u0_y, u0_x). Continuous across the two.
+  // The near half (rim < 0) the same way with u0 reversed.
+  const DieModel& m = *m_;
+  const Vec3& k = m.rims.axis;
+  const Vec3& e1 = m.rims.perp;
+  const Vec3 e2 = k.cross(e1);
+  const double a = z_row.dot(e1), b = z_row.dot(e2), kz = z_row.dot(k);
+  const int ri = rim >= 0 ? rim : -rim - 1;
+  const double u0 = slap_u_[ri][0], u1 = slap_u_[ri][1];
+  const double base = z_row.dot(m.rims.centre) + (ri == 0 ? m.rims.half : -m.rims.half) * kz - m.rounding;
+  const bool far = rim >= 0;
+  const double dot = a * u0 + b * u1;
+  const double drop = (far ? dot >= 0.0 : dot <= 0.0) ? std::sqrt(a * a + b * b) : std::abs(b * u0 - a * u1);
+  return base - m.rims.radius * drop;
 }
 
 double FixedStepper::lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row, double t) const {
@@ -116,6 +148,7 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   if (impact_) a.imp = imp_;
   a.next.n = 0;
   a.capped = false;
+  a.clamped = false;
   s.velocity.z() -= m.gravity * d;
   // Built in place (the full step's is kept for model_G; the object is large, so no copies). A
   // curved die's support solve builds its own (rim_support: the rotation is part of its search).
@@ -173,11 +206,16 @@ double rim_low_z(const DieModel& m, const Vec3& z_row, int rim) {
 
 }  // namespace
 
+double FixedStepper::support_low(const Vec3& z_row, int rim) const {
+  return (slap_rims_ & (1 << rim)) ? slap_low(z_row, -rim - 1) : rim_low_z(*m_, z_row, rim);
+}
+
 void FixedStepper::rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
                                std::optional<TorqueFreeRotation>& rot, bool full) {
   start_support(s, c, d, e_start, a, rot);
   const DieModel& m = *m_;
   if (!(d > 0.0)) return;
+  if (full) free_end_row_ = rot->bottom_row(d);
   if (full && !slap_located_ && !(a.sup.normal_impulse > 0.0)) {
     // Leaving (no push) and first rising, yet below the floor at the step's end: the sinking is
     // another part of the rim arriving (rims_new_).
@@ -221,7 +259,7 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
     const Vec3 z_row = r0.bottom_row(t);
     double z = std::numeric_limits<double>::infinity();
     for (int r = 0; r < 2; ++r)
-      if (rim_in[r]) z = std::min(z, p0.z() + v0.z() * t + rim_low_z(m, z_row, r));
+      if (rim_in[r]) z = std::min(z, p0.z() + v0.z() * t + support_low(z_row, r));
     return z;
   };
   if (!(phi(d) < 0.0)) return;
@@ -265,7 +303,7 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
     const Vec3 z_row = r1.bottom_row(rest);
     double gap = std::numeric_limits<double>::infinity();
     for (int r = 0; r < 2; ++r)
-      if (rim_in[r]) gap = std::min(gap, mid.position.z() + mid.velocity.z() * rest + rim_low_z(m, z_row, r));
+      if (rim_in[r]) gap = std::min(gap, mid.position.z() + mid.velocity.z() * rest + support_low(z_row, r));
     return gap;
   };
   const auto energy_end = [&] {
@@ -306,6 +344,7 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
     b = ok;
     g = solve(b);
     ++curvature_capped;
+    a.clamped = true;
     a.capped = g < -touch_tol_;
   }
   ++curvature_impulses;
@@ -669,12 +708,47 @@ int FixedStepper::step(RigidState& s) {
     if (impact_) imp_ = apply_friction_impact(m, s0, c, /*restitution=*/true, nullptr, nullptr, &geo_);
   }
   rims_new_ = false;
+  slap_rims_ = 0;
   miss_rate_ = 0.0;
   hermite_ = false;
   try_step(s0, c, h_, a_, /*full=*/true);
+  if (m.curved() && c.n > 0 && !rims_new_) {
+    // A slap (slap_rims_): a touching rim whose lowest point, in the body, turns by more than
+    // 90 deg along it over the full step's free motion after the start's solve (its tilt passes
+    // through or near zero), the far half of it clear of the floor at the start. The full step
+    // is then tried again as a slap's: its new contact the far half (slap_low), the curvature
+    // impulse holding only the near half (support_low), and shortened to the far half's arrival,
+    // where the next step strikes it (impact first, with restitution). If the far half does not
+    // reach the floor in that step, the plain step stands.
+    const Vec3& e1 = m.rims.perp;
+    const Vec3 e2 = m.rims.axis.cross(e1);
+    const Vec3 z0 = s0.R.row(2).transpose(), z1 = free_end_row_;
+    const double a0 = z0.dot(e1), b0 = z0.dot(e2), a1 = z1.dot(e1), b1 = z1.dot(e2);
+    const double n0 = std::sqrt(a0 * a0 + b0 * b0);
+    for (int i = 0; i < c.n; ++i) {
+      const int r = c.vertex[i] < 3 ? 0 : 1;
+      if ((slap_rims_ & (1 << r)) || !(n0 > 0.0) || !(a0 * a1 + b0 * b1 < 0.0)) continue;
+      slap_u_[r][0] = -a0 / n0;
+      slap_u_[r][1] = -b0 / n0;
+      if (s0.position.z() + slap_low(z0, r) > touch_tol_) slap_rims_ |= 1 << r;
+    }
+    if (slap_rims_ != 0) {
+      try_step(s0, c, h_, a_, /*full=*/true);
+      if (!(a_.G < -touch_tol_)) {
+        slap_rims_ = 0;
+        try_step(s0, c, h_, a_, /*full=*/true);
+      }
+    }
+  }
   const Attempt* done = &a_;
   double dt = h_;
-  if (a_.G < -touch_tol_) {
+  // The search for a new contact's instant (below), run again as the plain step's if a slap's
+  // located step leaves the rest of its rim below the floor (then the far half was not the first
+  // part to arrive: the lowest point ran round the rim, a roll, which the curvature impulse holds).
+  const auto locate = [&] {
+  done = &a_;
+  dt = h_;
+  if (!(a_.G < -touch_tol_)) return;
     // A corner not yet touching would end the step below the floor. The step is shortened to the
     // instant it touches: the length d whose whole step (gravity's kick g d, the contact solve,
     // the free motion) ends with that corner on the floor, G(d) = 0 (G: the lowest such corner's
@@ -688,7 +762,7 @@ int FixedStepper::step(RigidState& s) {
     const Vec3 z_row = s0.R.row(2).transpose();
     double g_lo = std::numeric_limits<double>::infinity();
     if (m.curved()) {
-      g_lo = s0.position.z() + (rims_new_ ? rim_lowest(m, s0.R) : rim_lowest_excluding(m, s0.R, c));
+      g_lo = s0.position.z() + curved_low(c, s0.R);
     } else {
       int j = 0;
       for (int i = 0; i < static_cast<int>(m.vertices.size()); ++i) {
@@ -803,8 +877,29 @@ int FixedStepper::step(RigidState& s) {
       }
     }
     ++located;
+  };
+  locate();
+  if (slap_rims_ != 0 && done->capped) {
+    // A slap's step whose near half the capped curvature impulse leaves sinking: halved as a
+    // plain step would be (below), still a slap's (its end then before the far half's arrival).
+    Attempt* buf = done == &b_ ? &lo_ : &b_;
+    double d = dt;
+    for (int k = 0; k < kMaxHalvings && done->capped; ++k) {
+      d *= 0.5;
+      try_step(s0, c, d, *buf);
+      done = buf;
+      dt = d;
+      buf = buf == &b_ ? &lo_ : &b_;
+    }
+    ++halved;
   }
-  if (m.curved() && done->capped) {
+  if (slap_rims_ != 0 && done->s.position.z() + rim_lowest(m, done->s.R) < -touch_tol_) {
+    slap_rims_ = 0;
+    try_step(s0, c, h_, a_, /*full=*/true);
+    locate();
+  }
+  if (m.curved() && done->capped && slap_rims_ == 0) {
+    // (Not a slap's step: its end is the far half's arrival, which a halving would miss.)
     // The curvature impulse could not hold the rims on the floor without gaining energy: the
     // lowest point's height is far from quadratic over the step (a near-flat coin spinning fast,
     // its lowest point running round the rim: the slap), or the step's gravity, kicked at its
@@ -829,6 +924,9 @@ int FixedStepper::step(RigidState& s) {
     sweeps += static_cast<std::uint64_t>(a.imp.iterations);
     max_energy_gain = std::max(max_energy_gain, relative_gain(a.imp.energy_before, a.imp.energy_after));
   }
+  // An accepted step whose curvature impulse was capped (to gain no energy) is a clamp, counted
+  // as the start's are (the step itself then holds the rims with less than the exact end gap).
+  if (a.clamped) ++corrections.energy_clamps;
   if (c.n > 0) {
     corrections.add(a.sup.corrections);
     sweeps += static_cast<std::uint64_t>(a.sup.iterations);
@@ -842,6 +940,7 @@ int FixedStepper::step(RigidState& s) {
   }
   dt_ = dt;
   slap_located_ = rims_new_ && dt < h_;
+  if (slap_rims_ != 0 && dt < h_) ++slaps;
   max_energy_gain = std::max(max_energy_gain, relative_gain(E0, mechanical_energy(m, s)));
   if (m.curved()) {
     // The rims end every step within the touch tolerance of the floor or above it; where the step
@@ -881,6 +980,9 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->located_trials += st.located_trials;
       stats->max_energy_gain = std::max(stats->max_energy_gain, st.max_energy_gain);
       stats->max_penetration = std::max(stats->max_penetration, st.max_penetration);
+      stats->halved += st.halved;
+      stats->curvature_capped += st.curvature_capped;
+      stats->slaps += st.slaps;
     }
     return out;
   };

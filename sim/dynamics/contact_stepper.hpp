@@ -77,6 +77,7 @@ class FixedStepper {
   std::uint64_t curvature_capped = 0;    // ... of them capped to gain no energy
   std::uint64_t start_capped = 0;        // curved dice: start solves capped to gain no energy (energy_clamps)
   std::uint64_t halved = 0;              // curved dice: steps halved because the cap left them sinking
+  std::uint64_t slaps = 0;               // curved dice: steps shortened to a slapping face's arrival
 
  private:
   // One trial step of length d from s0 with contact set c; full: the step of length h, whose
@@ -88,6 +89,7 @@ class FixedStepper {
     ContactImpulses next;
     double G = 0.0;  // lowest height at the step's end over corners not in c
     bool capped = false;  // curved: the curvature impulse was capped and left the rims below the floor
+    bool clamped = false; // curved: the curvature impulse was capped (to gain no energy) at all
   };
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
   // A curved die's support solve for a step of length d (gravity's kick already in s): the plastic
@@ -128,6 +130,17 @@ class FixedStepper {
   // returned point.
   double model_root(const ContactSet& c, double miss, double lo, double hi, double f_lo, double f_hi,
                     double& g_model) const;
+  // A curved die's lowest height relative to the COM over what counts as a new contact at
+  // orientation R: the features not in c, or the whole rim (rims_new_), or, in a slap, the far
+  // half of the slapping rim (slap_low).
+  double curved_low(const ContactSet& c, const Mat3& R) const;
+  // The lowest point, relative to the COM, of the half of rim `rim` whose body directions make
+  // more than 90 deg with slap_u_[rim] (the rim's lowest point at the slap's start), in closed form.
+  // rim < 0: the near half of rim -rim - 1 instead.
+  double slap_low(const Vec3& z_row, int rim) const;
+  // The touching rim's lowest point the curvature impulse holds: the whole rim, or in a slap the
+  // near half (the far half is the arriving part).
+  double support_low(const Vec3& z_row, int rim) const;
   // The lowest height over corners not in c, at time t of the free motion after the step's solve.
   double lowest_new(const ContactSet& c, const Vec3& p, const Vec3& v, const TorqueFreeRotation& rot, double t) const;
   // The same for a flat-faced die, given the orientation's bottom row at t.
@@ -164,6 +177,17 @@ class FixedStepper {
   // a rim whose lowest point sinks from the start would be located again at once.
   bool rims_new_ = false;
   bool slap_located_ = false;  // the last step was shortened to such an arrival
+  // A near-flat coin's face slapping down (pivoting on one rim point about a near-horizontal axis):
+  // the touching rim's lowest point turns by more than 90 deg along the rim within the step (its
+  // tilt passes through or near zero). Then the far half of that rim is the arriving part
+  // (slap_low): the step is shortened to the instant it reaches the floor and the next step
+  // strikes it (an impact, as a polyhedron's face landing). slap_rims_: bit r for rim r; slap_u_:
+  // each one's lowest direction at the step's start in the rim's body basis (perp, axis x perp).
+  // A slap located step whose whole rim still ends below the floor (the lowest point ran round the
+  // rim on the near half first) is dropped for the plain step.
+  int slap_rims_ = 0;
+  Vec3 free_end_row_ = Vec3::Zero();  // the full step's bottom row at its end, after the start's solve only
+  double slap_u_[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
   bool impact_ = false;   // the current step starts with an impact (solved once for all its trials)
   ImpactResult imp_;      // that impact's result
 };
@@ -185,6 +209,11 @@ struct StepperStats {
   std::uint64_t located_trials = 0;  // their trial steps of shortened length
   double max_energy_gain = 0.0;
   double max_penetration = 0.0;  // curved dice: deepest lowest point below the floor at a step's end (m)
+  // Curved dice, adaptive steps (not corrections): steps halved because a capped curvature impulse
+  // left the rims sinking, curvature impulses capped (in any trial), steps shortened to a slap.
+  std::uint64_t halved = 0;
+  std::uint64_t curvature_capped = 0;
+  std::uint64_t slaps = 0;
 };
 
 // Steps from (s, t) until the die must come to rest (sim/rest.hpp), the time cap, the impact cap

@@ -34,6 +34,9 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
       probe->located_trials += stats.located_trials;
       probe->max_energy_gain = std::max(probe->max_energy_gain, stats.max_energy_gain);
       probe->max_penetration = std::max(probe->max_penetration, stats.max_penetration);
+      probe->halved += stats.halved;
+      probe->curvature_capped += stats.curvature_capped;
+      probe->slaps += stats.slaps;
     }
     return r;
   };

@@ -22,6 +22,9 @@ TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossPro
     probe->located_trials += stats.located_trials;
     probe->max_energy_gain = std::max(probe->max_energy_gain, stats.max_energy_gain);
     probe->max_penetration = std::max(probe->max_penetration, stats.max_penetration);
+    probe->halved += stats.halved;
+    probe->curvature_capped += stats.curvature_capped;
+    probe->slaps += stats.slaps;
   }
   if (probe && probe->final_state) *probe->final_state = s;
   r.corrections = stats.corrections;

@@ -71,6 +71,9 @@ struct TossProbe {
   std::uint64_t located_trials = 0;  // their trial steps (each a whole step of shortened length)
   double max_energy_gain = 0.0;
   double max_penetration = 0.0;  // curved dice: deepest rim below the floor at any fixed step's end (m)
+  std::uint64_t halved = 0;            // curved dice: fixed steps halved (a capped curvature impulse)
+  std::uint64_t curvature_capped = 0;  // curved dice: curvature impulses capped to gain no energy (any trial)
+  std::uint64_t slaps = 0;             // curved dice: fixed steps shortened to a slapping face's arrival
   RigidState* final_state = nullptr;           // impulse, stepped: the state when the toss ended
 };
 
