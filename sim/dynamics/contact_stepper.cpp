@@ -879,9 +879,9 @@ int FixedStepper::step(RigidState& s) {
     ++located;
   };
   locate();
-  if (slap_rims_ != 0 && done->capped) {
-    // A slap's step whose near half the capped curvature impulse leaves sinking: halved as a
-    // plain step would be (below), still a slap's (its end then before the far half's arrival).
+  // The accepted step halved (at most kMaxHalvings times) while its capped curvature impulse
+  // leaves the rims sinking (why it happens: below).
+  const auto halve_while_capped = [&] {
     Attempt* buf = done == &b_ ? &lo_ : &b_;
     double d = dt;
     for (int k = 0; k < kMaxHalvings && done->capped; ++k) {
@@ -892,7 +892,10 @@ int FixedStepper::step(RigidState& s) {
       buf = buf == &b_ ? &lo_ : &b_;
     }
     ++halved;
-  }
+  };
+  // A slap's step whose near half the capped curvature impulse leaves sinking: halved as a plain
+  // step would be, still a slap's (its end then before the far half's arrival).
+  if (slap_rims_ != 0 && done->capped) halve_while_capped();
   if (slap_rims_ != 0 && done->s.position.z() + rim_lowest(m, done->s.R) < -touch_tol_) {
     slap_rims_ = 0;
     try_step(s0, c, h_, a_, /*full=*/true);
@@ -906,15 +909,7 @@ int FixedStepper::step(RigidState& s) {
     // start, is out of phase with the middle's impulse by g P d / 2 (a disc rolling on its rim
     // with w^2 a >> g, Euler's disk). Shorter steps, halved (at most kMaxHalvings times) until it
     // holds; what is still below the floor then is lifted, counted (overlap_fixes).
-    Attempt* buf = done == &b_ ? &lo_ : &b_;
-    double d = dt;
-    for (int k = 0; k < kMaxHalvings && done->capped; ++k) {
-      d *= 0.5;
-      try_step(s0, c, d, *buf);
-      done = buf;
-      dt = d;
-    }
-    ++halved;
+    halve_while_capped();
   }
   const Attempt& a = *done;
   s = a.s;
