@@ -746,9 +746,9 @@ int FixedStepper::step(RigidState& s) {
   // located step leaves the rest of its rim below the floor (then the far half was not the first
   // part to arrive: the lowest point ran round the rim, a roll, which the curvature impulse holds).
   const auto locate = [&] {
-  done = &a_;
-  dt = h_;
-  if (!(a_.G < -touch_tol_)) return;
+    done = &a_;
+    dt = h_;
+    if (!(a_.G < -touch_tol_)) return;
     // A corner not yet touching would end the step below the floor. The step is shortened to the
     // instant it touches: the length d whose whole step (gravity's kick g d, the contact solve,
     // the free motion) ends with that corner on the floor, G(d) = 0 (G: the lowest such corner's
