@@ -17,6 +17,7 @@
 #include "sim/models/fidelity_models.hpp"
 #include "sim/models/toss.hpp"
 #include "sim/dynamics/contact_stepper.hpp"
+#include "sim/dynamics/friction_impact.hpp"
 #include "sim/scene/scene_error.hpp"
 #include "sim/study/statistics.hpp"
 
@@ -443,6 +444,72 @@ TEST(CylinderImpulse, SlappingFaceIsStruck) {
       EXPECT_GE(st.impacts, 1) << at;  // the face's arrival
       EXPECT_LE(st.max_energy_gain, 1e-12) << at;
     }
+  }
+}
+
+// A quarter on its side (scenes/coins/quarter.toml, `impulse`, seed 1: the start solves of tosses
+// 831 and 3084, and 19083 of 2e4), both rims' lowest points touching 1.35 mm apart, rolling and
+// pivoting: the plastic two-point solve reached Gauss-Seidel's sweep cap and its Newton finish
+// stalled (pgs_unconverged; the iterate left one point approaching at 2e-5 of the speeds). Their
+// normal rows are 0.975 correlated (the split tips the coin about a diameter, moving the points
+// sideways ~18 times more than vertically), and the answer has one point sticking, the other
+// sliding, where the Newton step is no descent. The exact solve by active sets
+// (solve_plastic_pair, friction_impact.cpp) takes them: Coulomb's law at both points, and the
+// impulses of Gauss-Seidel run to convergence (3 700-5 100 sweeps). The states replayed with their warm starts.
+TEST(CylinderImpulse, CoinOnItsSideTwoPointSolveConverges) {
+  const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter.toml",
+                                        {"sim.fidelity=\"impulse\""}));
+  struct Case {
+    int toss;
+    double vw[6], R[9], warm[3];
+    double pn[2];  // Gauss-Seidel's normal impulses after 40 000 sweeps (converged there)
+  };
+  const Case cases[] = {
+      {831,
+       {-0x1.3799fdde2715ep-3, -0x1.508fa28fcbd75p-4, -0x1.418ee6cb144f9p-7, 0x1.b175718cb8fcep+2, -0x1.914ccd8d23666p+3, -0x1.4505e86182699p-4},
+       {-0x1.53d92dc66d2ebp-1, -0x1.2799c65e9e64cp-1, 0x1.e6e5cccd7ccdcp-2, -0x1.6f5f774079b42p-2, -0x1.3f8a80fa87ba3p-2, -0x1.c26b1763a96a4p-1, 0x1.5003f4698bbfp-1, -0x1.825016fb00947p-1, -0x1.8678a131b63ep-22},
+       {0, 0x1.a36ce59f45243p-21, 0x1.ea894e902e0a6p-21},
+       {2.4021777010e-05, 3.1534961470e-05}},
+      {3084,
+       {0x1.e3b1ff906ca9bp-4, -0x1.2827f6d02d056p-10, -0x1.4191623a4bc79p-7, 0x1.7cce69ea7fd8p-4, 0x1.3773dd746ee5bp+3, -0x1.5dec32a951ff4p-4},
+       {0x1.ffaba502e39dfp-1, 0x1.1c68b20a66cb5p-5, 0x1.27aad66b70f9ap-7, -0x1.277d2047aee13p-7, -0x1.48c573f588e5ap-12, 0x1.fffaaa0c31215p-1, 0x1.1c6baa2195965p-5, -0x1.ffb0fa2327c17p-1, -0x1.1e83f6cb90008p-22},
+       {0, -0x1.32322bcfb0d45p-20, -0x1.c63b95fd7b23bp-22},
+       {2.3716957490e-05, 3.1841456190e-05}},
+      {19083,
+       {-0x1.8ea1676272f4fp-7, 0x1.36e94f0e26412p-2, -0x1.41922e88d440ep-7, -0x1.9068ee140f1b8p+4, -0x1.0096759f3df62p+0, 0x1.25a9a8956923fp-4},
+       {-0x1.43550080ef388p-5, 0x1.5383e401eea3cp-8, 0x1.ff981b48186e9p-1, 0x1.fb3e85d2048c6p-1, -0x1.0a4a1fc16e531p-3, 0x1.461af94bdb6cp-5, 0x1.0a803651fab45p-3, 0x1.fba5884e20c78p-1, -0x1.13d93ab15257p-21},
+       {0, -0x1.1259fb3f7f46p-21, -0x1.f44ac2cc05254p-21},
+       {2.3450828060e-05, 3.2108124240e-05}},
+  };
+  for (const Case& k : cases) {
+    RigidState s;
+    s.velocity = Vec3(k.vw[0], k.vw[1], k.vw[2]);
+    s.omega = Vec3(k.vw[3], k.vw[4], k.vw[5]);
+    for (int i = 0; i < 9; ++i) s.R(i / 3, i % 3) = k.R[i];
+    ContactSet c;
+    c.n = 2;
+    c.vertex[0] = 0;  // rim 0's lowest point
+    c.vertex[1] = 3;  // rim 1's
+    ContactImpulses warm, out;
+    warm.n = 1;
+    warm.vertex[0] = 0;
+    warm.P[0] = Vec3(k.warm[0], k.warm[1], k.warm[2]);
+    const double speed = s.velocity.norm() + s.omega.norm() * m.bounding_radius;
+    const ImpactResult r = apply_friction_impact(m, s, c, /*restitution=*/false, &warm, &out);
+    EXPECT_EQ(r.corrections.pgs_unconverged, 0u) << k.toss;
+    EXPECT_EQ(r.corrections.fallbacks, 0u) << k.toss;
+    EXPECT_EQ(r.corrections.energy_clamps, 0u) << k.toss;
+    for (int i = 0; i < 2; ++i) {
+      const Vec3 u = corner_velocity(m, s, c.vertex[i]);
+      EXPECT_GE(u.z(), -1e-10 * speed) << k.toss << " point " << i;
+      EXPECT_GT(out.P[i].z(), 0.0) << k.toss << " point " << i;
+      EXPECT_LE(std::hypot(out.P[i].x(), out.P[i].y()), m.max_friction * out.P[i].z() * (1.0 + 1e-9)) << k.toss;
+      EXPECT_NEAR(out.P[i].z(), k.pn[i], 1e-6 * k.pn[i]) << k.toss << " point " << i;
+    }
+  }
+  for (const std::uint64_t i : {831u, 3084u}) {
+    const TossResult r = toss(m, 1, i);
+    EXPECT_EQ(r.corrections.pgs_unconverged, 0u) << i;
   }
 }
 

@@ -15,7 +15,10 @@
 //     every sweep lowers the energy; warm-started, symmetric sweeps, converged to 1e-11 of the
 //     speeds; a solve still unconverged at the sweep cap (an edge near the stick-slip boundary:
 //     two corners' compliance has rank 5) is finished by semismooth Newton on the Alart-Curnier
-//     equations, and counted (pgs_unconverged) only if that fails too. The lever arms of a
+//     equations; two points it leaves unconverged (a coin on its side, its two rims' lowest points
+//     touching close together: friction_impact.cpp, solve_plastic_pair) are solved exactly by
+//     their active sets (both stick, one sticks and one slides, both slide), and a solve is
+//     counted (pgs_unconverged) only if that fails too. The lever arms of a
 //     multi-point solve lie in one contact plane (the lowest point's height) when its points are
 //     within 1e-6 r of it: corners touching within the tolerance but out of level by ~1e-9 m
 //     made a face's problem inconsistent.
