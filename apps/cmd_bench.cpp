@@ -110,6 +110,10 @@ nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
           {"halved_steps_per_toss", static_cast<double>(probe.halved) / np},
           {"curvature_capped_per_toss", static_cast<double>(probe.curvature_capped) / np},
           {"slaps_per_toss", static_cast<double>(probe.slaps) / np},
+          // The slap's re-decisions: the plain step when its far half does not arrive, the plain
+          // search again when a located slap leaves the rest of the rim below the floor.
+          {"slap_no_arrival_per_toss", static_cast<double>(probe.slap_no_arrival) / np},
+          {"slap_rim_below_per_toss", static_cast<double>(probe.slap_rim_below) / np},
           {"timed_tosses", n_probe},
           {"timed_tosses_per_s", np / probe_total},
           {"phases", phases},
@@ -137,9 +141,10 @@ void print_text(const nlohmann::json& r) {
               r["search_steps_per_flight"].get<double>());
   if (r["fixed_steps_per_toss"].get<double>() > 0) {
     std::printf("  fixed steps/toss    %.1f\n", r["fixed_steps_per_toss"].get<double>());
-    std::printf("    located %.3f  halved %.3f  capped curvature %.3f  slaps %.3f (per toss)\n",
+    std::printf("    located %.3f  halved %.3f  capped curvature %.3f  slaps %.3f (no arrival %.4f, rim below %.4f) (per toss)\n",
                 r["located_steps_per_toss"].get<double>(), r["halved_steps_per_toss"].get<double>(),
-                r["curvature_capped_per_toss"].get<double>(), r["slaps_per_toss"].get<double>());
+                r["curvature_capped_per_toss"].get<double>(), r["slaps_per_toss"].get<double>(),
+                r["slap_no_arrival_per_toss"].get<double>(), r["slap_rim_below_per_toss"].get<double>());
   }
   std::printf("  time split (one thread, each phase timed: %.0f tosses/s while timed)\n",
               r["timed_tosses_per_s"].get<double>());
@@ -235,7 +240,8 @@ void register_bench(CLI::App& app, int& exit_code) {
                 "One JSON object on stdout: scene, shape, and per fidelity (\"fidelities\": [...]) tosses_per_s_1_thread,\n"
                 "tosses_per_s (all threads), scaling_efficiency, identical_counts, impacts_per_toss,\n"
                 "search_steps_per_flight, fixed_steps_per_toss, located_steps_per_toss,\n"
-                "halved_steps_per_toss, curvature_capped_per_toss, slaps_per_toss, phases {name: {share, per_toss, us_each}},\n"
+                "halved_steps_per_toss, curvature_capped_per_toss, slaps_per_toss, slap_no_arrival_per_toss,\n"
+                "slap_rim_below_per_toss, phases {name: {share, per_toss, us_each}},\n"
                 "other_share; with one fidelity its fields also at the top level");
   cmd->callback([args, &exit_code] { exit_code = run_bench(*args); });
 }

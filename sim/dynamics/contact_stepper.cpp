@@ -735,6 +735,7 @@ int FixedStepper::step(RigidState& s) {
     if (slap_rims_ != 0) {
       try_step(s0, c, h_, a_, /*full=*/true);
       if (!(a_.G < -touch_tol_)) {
+        ++slap_no_arrival;
         slap_rims_ = 0;
         try_step(s0, c, h_, a_, /*full=*/true);
       }
@@ -897,6 +898,7 @@ int FixedStepper::step(RigidState& s) {
   // step would be, still a slap's (its end then before the far half's arrival).
   if (slap_rims_ != 0 && done->capped) halve_while_capped();
   if (slap_rims_ != 0 && done->s.position.z() + rim_lowest(m, done->s.R) < -touch_tol_) {
+    ++slap_rim_below;
     slap_rims_ = 0;
     try_step(s0, c, h_, a_, /*full=*/true);
     locate();
@@ -978,6 +980,8 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->halved += st.halved;
       stats->curvature_capped += st.curvature_capped;
       stats->slaps += st.slaps;
+      stats->slap_no_arrival += st.slap_no_arrival;
+      stats->slap_rim_below += st.slap_rim_below;
     }
     return out;
   };

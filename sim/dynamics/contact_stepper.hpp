@@ -78,6 +78,11 @@ class FixedStepper {
   std::uint64_t start_capped = 0;        // curved dice: start solves capped to gain no energy (energy_clamps)
   std::uint64_t halved = 0;              // curved dice: steps halved because the cap left them sinking
   std::uint64_t slaps = 0;               // curved dice: steps shortened to a slapping face's arrival
+  // Curved dice: the slap's two re-decisions (step()): the plain step taken because a slap's far
+  // half does not reach the floor within the full step, and the plain step's search run again
+  // because a located slap step left the rest of the rim below the floor.
+  std::uint64_t slap_no_arrival = 0;
+  std::uint64_t slap_rim_below = 0;
 
  private:
   // One trial step of length d from s0 with contact set c; full: the step of length h, whose
@@ -214,6 +219,8 @@ struct StepperStats {
   std::uint64_t halved = 0;
   std::uint64_t curvature_capped = 0;
   std::uint64_t slaps = 0;
+  std::uint64_t slap_no_arrival = 0;  // a slap's far half did not arrive: the plain step taken
+  std::uint64_t slap_rim_below = 0;   // a located slap left the rest of the rim below: the plain search again
 };
 
 // Steps from (s, t) until the die must come to rest (sim/rest.hpp), the time cap, the impact cap

@@ -25,6 +25,8 @@ TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossPro
     probe->halved += stats.halved;
     probe->curvature_capped += stats.curvature_capped;
     probe->slaps += stats.slaps;
+    probe->slap_no_arrival += stats.slap_no_arrival;
+    probe->slap_rim_below += stats.slap_rim_below;
   }
   if (probe && probe->final_state) *probe->final_state = s;
   r.corrections = stats.corrections;
