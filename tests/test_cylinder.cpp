@@ -513,6 +513,23 @@ TEST(CylinderImpulse, CoinOnItsSideTwoPointSolveConverges) {
   }
 }
 
+// A quarter landing flat on its face (tilt ~1e-7 rad, falling at 0.1-0.3 m/s, turning at 10-60
+// rad/s about a near-horizontal axis): the rim's features 120 deg from its lowest point were just
+// outside the touch tolerance, so the contact set was one point, the face's far side struck
+// nothing, and the capped curvature impulse left it to be lifted. The face's tripod now joins the
+// set within the strike tolerance (FixedStepper::add_face_tripod). Tosses of
+// scenes/coins/quarter.toml (`impulse`, seed 1) that each lifted once before.
+TEST(CylinderImpulse, FaceLandingFlatStrikesItsTripod) {
+  const DieModel m =
+      compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter.toml", {"sim.fidelity=\"impulse\""}));
+  for (const std::uint64_t i : {1568u, 2977u, 4170u, 19608u}) {
+    TossProbe probe;
+    const TossResult r = toss(m, 1, i, &probe);
+    EXPECT_EQ(r.corrections.overlap_fixes, 0u) << i;
+    EXPECT_LE(probe.max_energy_gain, 1e-12) << i;
+  }
+}
+
 // The quarter that lands spinning upright about the vertical (2.4 % of quarter-table's `impulse`
 // tosses did, and stood there for 15-22 s): it rocks from rim to rim, rolling on each, and as the
 // spin slows the rocking grows until it leaves the band (+-3.2 deg of upright, where the COM is

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "sim/body/rim.hpp"
 #include "sim/dynamics/contact.hpp"
@@ -682,6 +683,34 @@ long long FixedStepper::coast(RigidState& s, double& t, double max_time, long lo
   return static_cast<long long>(k);
 }
 
+void FixedStepper::add_face_tripod(const RigidState& s, ContactSet& c) const {
+  // A coin flat to within ~1e-7 rad (a slap's located end: the far half arrives as the tilt
+  // passes zero) touches with its whole face, but the features 120 deg either side of the rim's
+  // lowest point sit 1.5 a tilt above it, just outside the touch tolerance: the contact set was the
+  // lowest point alone, the face's far side (arriving at ~w 2a) struck nothing, the curvature
+  // impulse could not hold it without gaining energy (capped, halved four times) and it was
+  // lifted. The face's tripod joins the set when its features are within the impulse model's
+  // strike tolerance (1e-6 r, corners that close strike together), as a polyhedron's face does.
+  const DieModel& m = *m_;
+  const double face_tol = 1e-6 * m.bounding_radius;
+  const int n0 = c.n;
+  for (int r = 0; r < 2; ++r) {
+    bool low = false, in1 = false, in2 = false;
+    for (int i = 0; i < n0; ++i) {
+      low = low || c.vertex[i] == 3 * r;
+      in1 = in1 || c.vertex[i] == 3 * r + 1;
+      in2 = in2 || c.vertex[i] == 3 * r + 2;
+    }
+    if (!low || (in1 && in2)) continue;
+    if (corner_height(m, s, 3 * r + 1) > face_tol || corner_height(m, s, 3 * r + 2) > face_tol) continue;
+    if (!in1 && c.n < kMaxContacts) c.vertex[c.n++] = 3 * r + 1;
+    if (!in2 && c.n < kMaxContacts) c.vertex[c.n++] = 3 * r + 2;
+  }
+  if (c.n == n0) return;
+  for (int a = 1; a < c.n; ++a)  // ascending, as touching_corners leaves it
+    for (int b = a; b > 0 && c.vertex[b - 1] > c.vertex[b]; --b) std::swap(c.vertex[b - 1], c.vertex[b]);
+}
+
 // Trials of the shortened step's length (each a whole step) before taking the best one.
 constexpr int kMaxTrials = 12;
 // Halvings of a curved die's step whose curvature impulse was capped (step()).
@@ -691,6 +720,7 @@ int FixedStepper::step(RigidState& s) {
   const DieModel& m = *m_;
   ContactSet c;
   if (s.position.z() <= m.bounding_radius + touch_tol_) c = touching_corners(m, s, touch_tol_);
+  if (m.curved() && c.n > 0) add_face_tripod(s, c);
   const double E0 = mechanical_energy(m, s);
   // Impact first, at the instant of contact, on the velocity before gravity's kick: restitution
   // returns the approach speed the corner really had (after the kick it would return g h more,

@@ -97,6 +97,8 @@ class FixedStepper {
     bool clamped = false; // curved: the curvature impulse was capped (to gain no energy) at all
   };
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
+  // A curved die lying flat to within the strike tolerance: its face's tripod added to c.
+  void add_face_tripod(const RigidState& s, ContactSet& c) const;
   // A curved die's support solve for a step of length d (gravity's kick already in s): the plastic
   // solve, rolling resistance, and the touching rims' lowest points held on the floor at the
   // step's end by the curvature impulse at the step's middle (contact_stepper.cpp). Leaves s and
