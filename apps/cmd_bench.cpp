@@ -114,6 +114,14 @@ nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
           // search again when a located slap leaves the rest of the rim below the floor.
           {"slap_no_arrival_per_toss", static_cast<double>(probe.slap_no_arrival) / np},
           {"slap_rim_below_per_toss", static_cast<double>(probe.slap_rim_below) / np},
+          // A flat die's held corners: the deepest one below the floor at a step's end (m), the
+          // steps in which one sank more than the bound, and (`impulse`) the steps tried again
+          // shorter for the bound and those whose full length was below the contact step.
+          {"max_held_sink_m", probe.max_held_sink},
+          {"held_sinks_per_toss", static_cast<double>(probe.held_sinks) / np},
+          {"sink_shortened_per_toss", static_cast<double>(probe.sink_shortened) / np},
+          {"short_steps_per_toss", static_cast<double>(probe.short_steps) / np},
+          {"rise_dropped_per_toss", static_cast<double>(probe.rise_dropped) / np},
           {"timed_tosses", n_probe},
           {"timed_tosses_per_s", np / probe_total},
           {"phases", phases},
@@ -145,6 +153,13 @@ void print_text(const nlohmann::json& r) {
                 r["located_steps_per_toss"].get<double>(), r["halved_steps_per_toss"].get<double>(),
                 r["curvature_capped_per_toss"].get<double>(), r["slaps_per_toss"].get<double>(),
                 r["slap_no_arrival_per_toss"].get<double>(), r["slap_rim_below_per_toss"].get<double>());
+    if (r["max_held_sink_m"].get<double>() > 0)
+      std::printf(
+          "    held corners: deepest %.2g m  sank more than the bound %.3f  shortened %.3f  short %.3f  rise dropped "
+          "%.4f (per toss)\n",
+          r["max_held_sink_m"].get<double>(), r["held_sinks_per_toss"].get<double>(),
+          r["sink_shortened_per_toss"].get<double>(), r["short_steps_per_toss"].get<double>(),
+          r["rise_dropped_per_toss"].get<double>());
   }
   std::printf("  time split (one thread, each phase timed: %.0f tosses/s while timed)\n",
               r["timed_tosses_per_s"].get<double>());

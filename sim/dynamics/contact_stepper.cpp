@@ -14,11 +14,13 @@
 
 namespace dicesim {
 
-FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshold)
+FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshold, double max_sink)
     : m_(&m),
+      h_max_(h),
       h_(h),
       v_impact_(sustained_contact_speed(m, h)),
-      touch_tol_(1e-7 * m.bounding_radius) {
+      touch_tol_(1e-7 * m.bounding_radius),
+      max_sink_(m.curved() ? 0.0 : max_sink) {
   if (threshold == ImpactThreshold::Contact) {
     // Gravity keeps its safety factor 4; contact forces of order m g (normal plus friction) at
     // lever r add at most (1 + mu) g m r^2 / I_min per unit time; the spin adds |w|^2 r (factor 4).
@@ -142,6 +144,31 @@ double FixedStepper::lowest_flat(const ContactSet& c, const Vec3& p, const Vec3&
 
 void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full) {
   const DieModel& m = *m_;
+  // `impulse` (hold_): a flat die's held corners are asked to end the step on the floor, v_n >= b
+  // at every one of them after the solve (the solve on the velocity shifted by -b e_z, then
+  // restored), b = depth / d + a_n d / 2: the shallowest one's depth at the start (what earlier
+  // steps left) and what the free rotation's downward acceleration a_n < 0 of the corners would
+  // sink them within the step (predicted_step). Without it a corner held while the die spins
+  // over it sank a micrometre a step, and kept sinking: up to 0.3 mm in 10^4 Die 1 tosses.
+  // b is at most gravity's kick g d, and the step may not gain energy as the rest rules count
+  // it, kinetic + m g (COM height + the deepest corner's depth) (rest.hpp): the rise lifts the
+  // COM by what the depth falls. At a resting corner, dE = m_eff b^2 / 2 - (m - m_eff)(b g d +
+  // g^2 d^2 / 2) (m_eff = 1 / W_nn), so b = g d costs energy only where m_eff > 3 m / 4 (a corner
+  // nearly under the COM). Checked at the step's end: if it gains, b / 4, then none: the plain
+  // step, which never gains kinetic + m g z (counted, rise_dropped; its corners' depth stays).
+  if (!hold_ || m.curved() || c.n == 0) {
+    try_step_with(s0, c, d, a, full, 0.0);
+    return;
+  }
+  const double b = std::min(start_shallow_ / d + 0.5 * a_down_ * d, m.gravity * d);
+  if (try_step_with(s0, c, d, a, full, b) || try_step_with(s0, c, d, a, full, 0.25 * b)) return;
+  try_step_with(s0, c, d, a, full, 0.0);
+  a.rise_dropped = true;
+}
+
+bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full,
+                                 double bias) {
+  const DieModel& m = *m_;
   // The impact (solved once per step in step(): it does not depend on d) is already in s0.
   a.s = s0;
   RigidState& s = a.s;
@@ -150,14 +177,19 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   a.next.n = 0;
   a.capped = false;
   a.clamped = false;
+  a.risen = bias > 0.0;
+  a.rise_dropped = false;
   s.velocity.z() -= m.gravity * d;
   // Built in place (the full step's is kept for model_G; the object is large, so no copies). A
   // curved die's support solve builds its own (rim_support: the rotation is part of its search).
   std::optional<TorqueFreeRotation>& slot = full ? full_rot_ : trial_rot_;
   const bool built = m.curved() && c.n > 0;
   if (built) rim_support(s, c, d, mechanical_energy(m, s0), a, slot, full);
-  if (!m.curved() && c.n > 0) a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
-
+  if (!m.curved() && c.n > 0) {
+    s.velocity.z() -= bias;
+    a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
+    s.velocity.z() += bias;
+  }
   // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact). A trial of
   // a step without contact has the full step's rotation exactly (the same s0.R and, with no
   // impulse, the same angular momentum): it is reused.
@@ -193,6 +225,14 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   s.position = p + d * v;
   s.R = R_end;
   s.omega = w;
+  if (!(bias > 0.0)) return true;
+  double depth_end = 0.0;  // (new corners below the floor are the located step's business)
+  const Vec3 z_end = R_end.row(2).transpose();
+  for (int i = 0; i < c.n; ++i)
+    depth_end = std::max(depth_end, -(s.position.z() + z_end.dot(m.vertices[static_cast<std::size_t>(c.vertex[i])]) -
+                                      m.rounding));
+  return kinetic_energy(m, s) + m.mass * m.gravity * (s.position.z() + depth_end) <=
+         mechanical_energy(m, s0) + m.mass * m.gravity * start_depth_max_;
 }
 
 namespace {
@@ -646,7 +686,7 @@ long long FixedStepper::coast(RigidState& s, double& t, double max_time, long lo
   // High: COM above z_min. The margin (1e-6 of the radius, far above the rounding of the closed
   // form against step by step) keeps every coasted step clear of the floor by construction.
   const double z_min = (1.0 + 1e-6) * m.bounding_radius + touch_tol_;
-  const double z0 = s.position.z(), vz = s.velocity.z(), g = m.gravity, h = h_;
+  const double z0 = s.position.z(), vz = s.velocity.z(), g = m.gravity, h = h_max_;
   // (No rest: energy >= m g z > m g r >= m g max_escape, the rest criteria's bound; a die with
   // one basin only, max_escape infinite, rests at once and never coasts.)
   if (!(z0 > z_min) || max_k < 2 || !(m.max_escape <= m.bounding_radius)) return 0;
@@ -711,6 +751,41 @@ void FixedStepper::add_face_tripod(const RigidState& s, ContactSet& c) const {
     for (int b = a; b > 0 && c.vertex[b - 1] > c.vertex[b]; --b) std::swap(c.vertex[b - 1], c.vertex[b]);
 }
 
+double FixedStepper::predicted_step(const RigidState& s0, const ContactSet& c) {
+  // A held corner r (from the COM) leaves the start's solve with normal velocity >= 0 and then
+  // moves with the free rotation: its height gains a_n d^2 / 2, a_n = e_z . (w x (w x r) + dw/dt x r)
+  // with dw/dt = -I_w^-1 (w x L) (torque-free, L = I_w w). (The solve changes w a little; the
+  // accepted step is checked, step().)
+  const DieModel& m = *m_;
+  const Vec3& w = s0.omega;
+  const Vec3 L = Iw_start_ * w;
+  const Vec3 wb = s0.R.transpose() * (w.cross(L));
+  const Vec3 alpha = -(s0.R * wb.cwiseQuotient(m.principal_moments));
+  double a_min = 0.0;
+  for (int i = 0; i < c.n; ++i) {
+    const Vec3 r = s0.R * m.vertices[static_cast<std::size_t>(c.vertex[i])];
+    a_min = std::min(a_min, (w.cross(w.cross(r)) + alpha.cross(r)).z());
+  }
+  a_down_ = -a_min;
+  if (!(a_min < 0.0)) return h_max_;
+  const double d = std::sqrt(2.0 * max_sink_ / -a_min);
+  return std::clamp(d, h_max_ / kMinStepDivisor, h_max_);
+}
+
+double FixedStepper::held_sink(const RigidState& s0, const RigidState& s, const ContactSet& c, double& depth) const {
+  const DieModel& m = *m_;
+  const Vec3 z0 = s0.R.row(2).transpose(), z1 = s.R.row(2).transpose();
+  double sink = -std::numeric_limits<double>::infinity();
+  depth = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < c.n; ++i) {
+    const Vec3& v = m.vertices[static_cast<std::size_t>(c.vertex[i])];
+    const double d0 = -(s0.position.z() + z0.dot(v) - m.rounding), d1 = -(s.position.z() + z1.dot(v) - m.rounding);
+    sink = std::max(sink, d1 - std::max(0.0, d0));
+    depth = std::max(depth, d1);
+  }
+  return sink;
+}
+
 // Trials of the shortened step's length (each a whole step) before taking the best one.
 constexpr int kMaxTrials = 12;
 // Halvings of a curved die's step whose curvature impulse was capped (step()).
@@ -741,6 +816,24 @@ int FixedStepper::step(RigidState& s) {
   slap_rims_ = 0;
   miss_rate_ = 0.0;
   hermite_ = false;
+  // `impulse` (max_sink_): the step's length from its held corners' predicted sink, and what
+  // they ask of the solve (try_step): the shallowest one's depth at the start, the deepest one's
+  // (the energy check), and a_down_.
+  a_down_ = 0.0;
+  start_shallow_ = start_depth_max_ = 0.0;
+  hold_ = max_sink_ > 0.0 && c.n > 0;
+  h_ = hold_ ? predicted_step(s0, c) : h_max_;
+  if (hold_) {
+    const Vec3 z_row = s0.R.row(2).transpose();
+    double shallow = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < c.n; ++i) {
+      const double depth =
+          -(s0.position.z() + z_row.dot(m.vertices[static_cast<std::size_t>(c.vertex[i])]) - m.rounding);
+      shallow = std::min(shallow, depth);
+      start_depth_max_ = std::max(start_depth_max_, depth);
+    }
+    start_shallow_ = shallow > touch_tol_ ? shallow : 0.0;
+  }
   try_step(s0, c, h_, a_, /*full=*/true);
   if (m.curved() && c.n > 0 && !rims_new_) {
     // A slap (slap_rims_): a touching rim whose lowest point, in the body, turns by more than
@@ -910,6 +1003,30 @@ int FixedStepper::step(RigidState& s) {
     ++located;
   };
   locate();
+  if (!m.curved() && c.n > 0 && max_sink_ > 0.0) {
+    // What the held corners sank in the accepted step, checked: more than max_sink_ (the start's
+    // solve turned the die, or the acceleration changed within the step), the whole step again,
+    // shorter by the sink's d^2 law (twice at most; not below the shortest step).
+    const double h_min = h_max_ / kMinStepDivisor;
+    for (int k = 0; k < 2; ++k) {
+      double depth;
+      const double sink = held_sink(s0, done->s, c, depth);
+      if (!(sink > max_sink_) || !(h_ > h_min)) break;
+      h_ = std::max(h_min, 0.9 * h_ * std::sqrt(max_sink_ / sink));
+      ++sink_shortened;
+      miss_rate_ = 0.0;
+      hermite_ = false;
+      try_step(s0, c, h_, a_, /*full=*/true);
+      locate();
+    }
+  }
+  if (!m.curved() && c.n > 0) {
+    double depth;
+    const double sink = held_sink(s0, done->s, c, depth);
+    max_held_sink = std::max(max_held_sink, depth);
+    if (sink > std::max(max_sink_, touch_tol_)) ++held_sinks;
+    if (h_ < h_max_) ++short_steps;
+  }
   // The accepted step halved (at most kMaxHalvings times) while its capped curvature impulse
   // leaves the rims sinking (why it happens: below).
   const auto halve_while_capped = [&] {
@@ -968,7 +1085,19 @@ int FixedStepper::step(RigidState& s) {
   dt_ = dt;
   slap_located_ = rims_new_ && dt < h_;
   if (slap_rims_ != 0 && dt < h_) ++slaps;
-  max_energy_gain = std::max(max_energy_gain, relative_gain(E0, mechanical_energy(m, s)));
+  if (a.risen) {
+    // A step whose held corners rose: no gain in the rest rules' energy, which adds the deepest
+    // corner's depth to the COM height (try_step's check).
+    double depth = 0.0;
+    const Vec3 z_row = s.R.row(2).transpose();
+    for (int i = 0; i < c.n; ++i)
+      depth = std::max(depth, -(s.position.z() + z_row.dot(m.vertices[static_cast<std::size_t>(c.vertex[i])]) - m.rounding));
+    max_energy_gain = std::max(max_energy_gain, relative_gain(E0 + m.mass * m.gravity * start_depth_max_,
+                                                              mechanical_energy(m, s) + m.mass * m.gravity * depth));
+  } else {
+    max_energy_gain = std::max(max_energy_gain, relative_gain(E0, mechanical_energy(m, s)));
+  }
+  if (a.rise_dropped) ++rise_dropped;
   if (m.curved()) {
     // The rims end every step within the touch tolerance of the floor or above it; where the step
     // left them deeper (a slapping rim, whose plain solve does not push, rim_support; a bias not
@@ -985,16 +1114,17 @@ int FixedStepper::step(RigidState& s) {
 }
 
 StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int& impacts, double h, double tiebreak,
-                               bool allow_liftoff, ImpactThreshold threshold, StepperStats* stats) {
+                               bool allow_liftoff, ImpactThreshold threshold, StepperStats* stats, double max_sink) {
   StepperOutcome out;
-  FixedStepper st(m, h, threshold);
+  FixedStepper st(m, h, threshold, max_sink);
   st.impacts = impacts;
   const double g = m.gravity, r = m.bounding_radius;
   const double ke_rest = 1e-14 * m.mass * g * r;
   const double nudge = 1e-4 * std::sqrt(g / r);
   // Steps shortened to a new contact make more steps than (max_time - t) / h: a generous cap on
   // the count as well, so that nothing can loop forever.
-  const auto max_steps = 4 * static_cast<long long>(std::ceil((m.max_time - t) / h)) + 1000;
+  const double h_min = max_sink > 0.0 ? h / FixedStepper::kMinStepDivisor : h;
+  const auto max_steps = 4 * static_cast<long long>(std::ceil((m.max_time - t) / h_min)) + 1000;
   std::uint64_t steps = 0;
   const auto finish = [&](StepperExit exit) {
     out.exit = exit;
@@ -1012,6 +1142,11 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->slaps += st.slaps;
       stats->slap_no_arrival += st.slap_no_arrival;
       stats->slap_rim_below += st.slap_rim_below;
+      stats->max_held_sink = std::max(stats->max_held_sink, st.max_held_sink);
+      stats->held_sinks += st.held_sinks;
+      stats->sink_shortened += st.sink_shortened;
+      stats->short_steps += st.short_steps;
+      stats->rise_dropped += st.rise_dropped;
     }
     return out;
   };

@@ -45,11 +45,25 @@ enum class ImpactThreshold { Gravity, Contact };
 // contacts are impacts, solved exactly at their instant.
 inline double sustained_contact_speed(const DieModel& m, double h) { return 4.0 * m.gravity * h; }
 
+// `impulse`'s bound on how far a held corner of a flat-faced die may end a step below the floor
+// (m). Over a step the touching corners move with the die's free rotation after the support
+// solve, and a corner whose centripetal and Euler acceleration points down, a_n < 0, ends it
+// a_n d^2 / 2 deep (the solve stops its approach at the start only). The step is shortened until
+// that depth is within this bound (FixedStepper's max_sink): 1e-4 of the bounding radius.
+inline double held_corner_sink(const DieModel& m) { return 1e-4 * m.bounding_radius; }
+
 class FixedStepper {
  public:
-  FixedStepper(const DieModel& m, double h, ImpactThreshold threshold = ImpactThreshold::Gravity);
+  // max_sink > 0 (a flat-faced die only): each step with contact is shortened from h, down to
+  // h / kMinStepDivisor at most, until its held corners end it no deeper than max_sink below the
+  // floor: predicted from their acceleration at the start, checked on the accepted step (and the
+  // step tried again shorter if deeper). 0: every step is h (the thresholds use h either way).
+  FixedStepper(const DieModel& m, double h, ImpactThreshold threshold = ImpactThreshold::Gravity,
+               double max_sink = 0.0);
+  static constexpr double kMinStepDivisor = 8.0;
 
-  // Advances s by one step: h, or less if a new corner reaches the floor first (last_dt()).
+  // Advances s by one step: h (or the step max_sink allows), or less if a new corner reaches the
+  // floor first (last_dt()).
   // Returns the number of corners that were in contact at the step's start.
   int step(RigidState& s);
 
@@ -64,7 +78,7 @@ class FixedStepper {
   // stops where t reaches max_time (the steps' own time cap). Returns K (0: s, t unchanged).
   long long coast(RigidState& s, double& t, double max_time, long long max_k) const;
 
-  double h() const { return h_; }
+  double h() const { return h_max_; }
   double last_dt() const { return dt_; }
   int impacts = 0;                // steps whose contact solve had restitution
   Corrections corrections;        // of every solve and step so far
@@ -83,8 +97,21 @@ class FixedStepper {
   // because a located slap step left the rest of the rim below the floor.
   std::uint64_t slap_no_arrival = 0;
   std::uint64_t slap_rim_below = 0;
+  double max_held_sink = 0.0;            // flat dice: deepest held corner below the floor at a step's end (m)
+  std::uint64_t held_sinks = 0;          // flat dice: steps in which a held corner sank more than max_sink (or touch_tol)
+  std::uint64_t sink_shortened = 0;      // flat dice, max_sink: steps tried again shorter (deeper than max_sink)
+  std::uint64_t short_steps = 0;         // flat dice, max_sink: steps whose full length was below h
+  std::uint64_t rise_dropped = 0;        // flat dice, max_sink: steps whose held corners' rise would gain energy (plain)
 
  private:
+  // The longest step (<= h_max_) whose held corners, moving with the die's free rotation from the
+  // step's start, sink no more than max_sink_ below the floor within it (to second order in d;
+  // what try_step's rise does not hold); sets a_down_.
+  double predicted_step(const RigidState& s0, const ContactSet& c);
+  // A flat die's corners of c from the step's start s0 to its end s: the most any of them sank
+  // (its depth at the end less its depth at the start, if it started below the floor) and, in
+  // depth, the deepest one's depth at the end (> 0: below the floor).
+  double held_sink(const RigidState& s0, const RigidState& s, const ContactSet& c, double& depth) const;
   // One trial step of length d from s0 with contact set c; full: the step of length h, whose
   // free motion is kept (full_*) as the model of the shortened steps.
   struct Attempt {
@@ -95,10 +122,15 @@ class FixedStepper {
     double G = 0.0;  // lowest height at the step's end over corners not in c
     bool capped = false;  // curved: the curvature impulse was capped and left the rims below the floor
     bool clamped = false; // curved: the curvature impulse was capped (to gain no energy) at all
+    bool risen = false;   // flat: the held corners were asked to rise (try_step); else the plain solve
+    bool rise_dropped = false;  // flat: they could not be without gaining energy (the plain solve instead)
   };
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
   // A curved die lying flat to within the strike tolerance: its face's tripod added to c.
   void add_face_tripod(const RigidState& s, ContactSet& c) const;
+  // try_step with the held corners asked to rise at `bias` (m/s, 0: none); false if that gains
+  // energy (kinetic + m g (COM height + the deepest corner's depth)).
+  bool try_step_with(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full, double bias);
   // A curved die's support solve for a step of length d (gravity's kick already in s): the plastic
   // solve, rolling resistance, and the touching rims' lowest points held on the floor at the
   // step's end by the curvature impulse at the step's middle (contact_stepper.cpp). Leaves s and
@@ -161,7 +193,17 @@ class FixedStepper {
   static constexpr int kSoaVertices = 64;
   int soa_vertices_ = 0;
   double vx_[kSoaVertices], vy_[kSoaVertices], vz_[kSoaVertices];
-  double h_, v_impact_, touch_tol_;
+  double h_max_;  // the contact step h (thresholds, coast)
+  double h_;      // the current step's full length (h_max_, or shorter for max_sink_)
+  double v_impact_, touch_tol_;
+  double max_sink_ = 0.0;
+  // The current step's held corners (max_sink_ > 0, try_step): whether they are held to the floor
+  // at its end, the deepest and the shallowest one's depth below the floor at its start (m, >= 0),
+  // and their most downward acceleration in the free rotation (m/s^2, >= 0; predicted_step).
+  bool hold_ = false;
+  double start_depth_max_ = 0.0;
+  double start_shallow_ = 0.0;
+  double a_down_ = 0.0;
   double v_spin_ = 0.0;  // Contact: 4 h r, the factor of |w|^2 in the threshold
   double dt_ = 0.0;
   Mat3 rot_start_ = Mat3::Identity();  // orientation at the start of the step being tried
@@ -223,6 +265,14 @@ struct StepperStats {
   std::uint64_t slaps = 0;
   std::uint64_t slap_no_arrival = 0;  // a slap's far half did not arrive: the plain step taken
   std::uint64_t slap_rim_below = 0;   // a located slap left the rest of the rim below: the plain search again
+  // Flat dice (not corrections: a step's discretisation, reported): the deepest held corner below
+  // the floor at a step's end, the steps that ended deeper than the max_sink bound, and with
+  // max_sink the steps tried again shorter and those whose full length was below h.
+  double max_held_sink = 0.0;
+  std::uint64_t held_sinks = 0;
+  std::uint64_t sink_shortened = 0;
+  std::uint64_t short_steps = 0;
+  std::uint64_t rise_dropped = 0;  // `impulse`: steps whose held corners' rise was dropped (it would gain energy)
 };
 
 // Steps from (s, t) until the die must come to rest (sim/rest.hpp), the time cap, the impact cap
@@ -232,6 +282,6 @@ struct StepperStats {
 // given, accumulates the corrections, sweeps and energy check of the steps.
 StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int& impacts, double h, double tiebreak,
                                bool allow_liftoff, ImpactThreshold threshold = ImpactThreshold::Gravity,
-                               StepperStats* stats = nullptr);
+                               StepperStats* stats = nullptr, double max_sink = 0.0);
 
 }  // namespace dicesim

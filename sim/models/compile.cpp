@@ -108,7 +108,9 @@ void build_outcomes(DieModel& m) {
 void finish_model(DieModel& m, const SceneDef& scene, const std::string& origin) {
   m.gravity = scene.sim.gravity;
   m.step = scene.sim.step;
-  m.contact_step = scene.sim.contact_step;
+  m.contact_step = scene.sim.contact_step > 0.0 ? scene.sim.contact_step
+                   : m.curved()                 ? kContactStepCurved
+                                                : kContactStepPolyhedron;
   m.stop_speed = scene.sim.stop_speed;
   m.max_bounces = scene.sim.max_bounces;
   m.max_time = scene.sim.max_time;

@@ -23,6 +23,11 @@ TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossPro
     probe->max_energy_gain = std::max(probe->max_energy_gain, stats.max_energy_gain);
     probe->max_penetration = std::max(probe->max_penetration, stats.max_penetration);
     probe->halved += stats.halved;
+    probe->max_held_sink = std::max(probe->max_held_sink, stats.max_held_sink);
+    probe->held_sinks += stats.held_sinks;
+    probe->sink_shortened += stats.sink_shortened;
+    probe->short_steps += stats.short_steps;
+    probe->rise_dropped += stats.rise_dropped;
     probe->curvature_capped += stats.curvature_capped;
     probe->slaps += stats.slaps;
     probe->slap_no_arrival += stats.slap_no_arrival;
