@@ -3,13 +3,35 @@
 // decides exact balances (PHYSICS.md, erratum 9: no hidden randomness).
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "sim/body/die_model.hpp"
+#include "sim/dynamics/contact_stepper.hpp"
 #include "sim/dynamics/flight.hpp"
 #include "sim/models/toss.hpp"
 
 namespace dicesim {
+
+// The stepper's statistics added to a probe (`impulse`'s sustained phases, `stepped`'s toss).
+inline void add_stepper_stats(TossProbe& probe, const StepperStats& stats) {
+  probe.pgs_sweeps += stats.sweeps;
+  probe.steps += stats.steps;
+  probe.located_steps += stats.located;
+  probe.located_trials += stats.located_trials;
+  probe.max_energy_gain = std::max(probe.max_energy_gain, stats.max_energy_gain);
+  probe.max_penetration = std::max(probe.max_penetration, stats.max_penetration);
+  probe.halved += stats.halved;
+  probe.max_held_sink = std::max(probe.max_held_sink, stats.max_held_sink);
+  probe.held_sinks += stats.held_sinks;
+  probe.sink_shortened += stats.sink_shortened;
+  probe.short_steps += stats.short_steps;
+  probe.rise_dropped += stats.rise_dropped;
+  probe.curvature_capped += stats.curvature_capped;
+  probe.slaps += stats.slaps;
+  probe.slap_no_arrival += stats.slap_no_arrival;
+  probe.slap_rim_below += stats.slap_rim_below;
+}
 
 // `static`: the initial orientation, then the quasi-static roll (sim/rest.hpp). No dynamics.
 TossResult run_static(const DieModel& m, const RigidState& s, double tiebreak);

@@ -16,22 +16,7 @@ TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossPro
   timer.stop();
   if (probe) {
     probe->flights += 1;
-    probe->pgs_sweeps += stats.sweeps;
-    probe->steps += stats.steps;
-    probe->located_steps += stats.located;
-    probe->located_trials += stats.located_trials;
-    probe->max_energy_gain = std::max(probe->max_energy_gain, stats.max_energy_gain);
-    probe->max_penetration = std::max(probe->max_penetration, stats.max_penetration);
-    probe->halved += stats.halved;
-    probe->max_held_sink = std::max(probe->max_held_sink, stats.max_held_sink);
-    probe->held_sinks += stats.held_sinks;
-    probe->sink_shortened += stats.sink_shortened;
-    probe->short_steps += stats.short_steps;
-    probe->rise_dropped += stats.rise_dropped;
-    probe->curvature_capped += stats.curvature_capped;
-    probe->slaps += stats.slaps;
-    probe->slap_no_arrival += stats.slap_no_arrival;
-    probe->slap_rim_below += stats.slap_rim_below;
+    add_stepper_stats(*probe, stats);
   }
   if (probe && probe->final_state) *probe->final_state = s;
   r.corrections = stats.corrections;
