@@ -226,13 +226,8 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   s.R = R_end;
   s.omega = w;
   if (!(bias > 0.0)) return true;
-  double depth_end = 0.0;  // (new corners below the floor are the located step's business)
-  const Vec3 z_end = R_end.row(2).transpose();
-  for (int i = 0; i < c.n; ++i)
-    depth_end = std::max(depth_end, -(s.position.z() + z_end.dot(m.vertices[static_cast<std::size_t>(c.vertex[i])]) -
-                                      m.rounding));
-  return kinetic_energy(m, s) + m.mass * m.gravity * (s.position.z() + depth_end) <=
-         mechanical_energy(m, s0) + m.mass * m.gravity * start_depth_max_;
+  // (New corners below the floor are the located step's business.)
+  return held_energy(s, c) <= mechanical_energy(m, s0) + m.mass * m.gravity * start_depth_max_;
 }
 
 namespace {
@@ -772,6 +767,15 @@ double FixedStepper::predicted_step(const RigidState& s0, const ContactSet& c) {
   return std::clamp(d, h_max_ / kMinStepDivisor, h_max_);
 }
 
+double FixedStepper::held_energy(const RigidState& s, const ContactSet& c) const {
+  const DieModel& m = *m_;
+  const Vec3 z_row = s.R.row(2).transpose();
+  double depth = 0.0;
+  for (int i = 0; i < c.n; ++i)
+    depth = std::max(depth, -(s.position.z() + z_row.dot(m.vertices[static_cast<std::size_t>(c.vertex[i])]) - m.rounding));
+  return mechanical_energy(m, s) + m.mass * m.gravity * depth;
+}
+
 double FixedStepper::held_sink(const RigidState& s0, const RigidState& s, const ContactSet& c, double& depth) const {
   const DieModel& m = *m_;
   const Vec3 z0 = s0.R.row(2).transpose(), z1 = s.R.row(2).transpose();
@@ -1088,12 +1092,8 @@ int FixedStepper::step(RigidState& s) {
   if (a.risen) {
     // A step whose held corners rose: no gain in the rest rules' energy, which adds the deepest
     // corner's depth to the COM height (try_step's check).
-    double depth = 0.0;
-    const Vec3 z_row = s.R.row(2).transpose();
-    for (int i = 0; i < c.n; ++i)
-      depth = std::max(depth, -(s.position.z() + z_row.dot(m.vertices[static_cast<std::size_t>(c.vertex[i])]) - m.rounding));
-    max_energy_gain = std::max(max_energy_gain, relative_gain(E0 + m.mass * m.gravity * start_depth_max_,
-                                                              mechanical_energy(m, s) + m.mass * m.gravity * depth));
+    max_energy_gain =
+        std::max(max_energy_gain, relative_gain(E0 + m.mass * m.gravity * start_depth_max_, held_energy(s, c)));
   } else {
     max_energy_gain = std::max(max_energy_gain, relative_gain(E0, mechanical_energy(m, s)));
   }

@@ -112,6 +112,9 @@ class FixedStepper {
   // (its depth at the end less its depth at the start, if it started below the floor) and, in
   // depth, the deepest one's depth at the end (> 0: below the floor).
   double held_sink(const RigidState& s0, const RigidState& s, const ContactSet& c, double& depth) const;
+  // The rest rules' energy of s (rest.hpp): kinetic + m g (COM height + the deepest corner of c's
+  // depth below the floor, if any).
+  double held_energy(const RigidState& s, const ContactSet& c) const;
   // One trial step of length d from s0 with contact set c; full: the step of length h, whose
   // free motion is kept (full_*) as the model of the shortened steps.
   struct Attempt {
