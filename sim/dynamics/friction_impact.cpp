@@ -1380,6 +1380,21 @@ ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol) 
   return c;
 }
 
+namespace {
+
+// Whether every point's tangential slip is at least mu times its approach speed (|u_t| >= mu |u_n|),
+// the state in which a plastic impulse at the friction cone's edge leaves the point sliding.
+bool slips_past_cone(const Body& b, const Points& pts) {
+  for (int i = 0; i < pts.n; ++i) {
+    const Vec3 u = b.point_velocity(pts.r[i]);
+    const double mu_un = pts.mu[i] * u.z();
+    if (u.x() * u.x() + u.y() * u.y() < mu_un * mu_un) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,
                                    const ContactImpulses* warm, ContactImpulses* out, ContactGeometry* geometry,
                                    bool direct) {
@@ -1423,9 +1438,14 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
     // A jam (no sliding direction found that stops the point): the general solve below takes it
     // (Gauss-Seidel, finished by Newton), counted only if that does not converge.
   }
-  if (!solved && direct && c.n >= 2 && !m.curved()) {
+  if (!solved && direct && c.n >= 2 && (!m.curved() || slips_past_cone(b, pts))) {
     // The two common cases directly: every point sliding (or lifting), then every point sticking;
-    // else the sweeps. (Polyhedral dice: a cylinder's rim solves stay with the sweeps.)
+    // else the sweeps. Each answer is kept only where Coulomb's law verifies at every point, so
+    // which solve runs first changes the cost, not the law. A cylinder's rim points try them only
+    // when every point slips faster than mu times its approach: slower, a rolling rim's points
+    // stick, the sliding iteration runs out without converging (85 000 times in 200 tosses of
+    // the three-sided coin), and the sweeps, warm-started, solve sticking rims faster than
+    // solve_sticking's 6x6 factorisation. (Polyhedra keep the unconditional order: their pins.)
     solved = solve_sliding(b, pts, speed, lever, pn, pt);
     if (!solved) solved = solve_sticking(b, Iw, pts, lever, pn, pt);
   }

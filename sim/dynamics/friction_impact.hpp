@@ -6,7 +6,7 @@
 //     P_n u_n = 0, |P_t| <= mu P_n, sticking if the impulse fits the cone, else sliding with the
 //     friction opposite the final slip (maximal dissipation). One point: exact (sticking
 //     P = -W^-1 u, else a bracketed root in the slip direction; W the contact compliance
-//     (1/m) 1 - [r]x I_w^-1 [r]x, u the point's velocity v + w x r). Several, on a polyhedral die:
+//     (1/m) 1 - [r]x I_w^-1 [r]x, u the point's velocity v + w x r). Several (a polyhedron's or a rim's):
 //     first directly, if every point of an edge or a triangle slides (or lifts), or if every point
 //     sticks (friction_impact.cpp: solve_sliding, solve_sticking; accepted only where Coulomb's
 //     law verifies); else projected
@@ -113,7 +113,7 @@ ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol);
 // Coulomb friction. Updates s.velocity and s.omega; positions are untouched. `warm`: impulses of
 // a previous solve (matched by vertex) to start the compression from; `out`: the impulse at every
 // point (compression plus restitution); `geometry`: the set-up shared with other solves of c at
-// s.R (see ContactGeometry). All optional. `direct`: a polyhedral die's multi-point plastic solve
+// s.R (see ContactGeometry). All optional. `direct`: a multi-point plastic solve
 // first tries the direct solves (every point sliding or lifting, then every point sticking;
 // friction_impact.cpp); false: always the Gauss-Seidel sweeps (the tests compare the two).
 ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,
