@@ -9,7 +9,7 @@
 //     (1/m) 1 - [r]x I_w^-1 [r]x, u the point's velocity v + w x r). Several (a polyhedron's or a rim's):
 //     first directly, if every point of an edge or a triangle slides (or lifts), or if every point
 //     sticks (friction_impact.cpp: solve_sliding, solve_sticking; accepted only where Coulomb's
-//     law verifies); else projected
+//     law verifies; a rim's only when every point slips past mu times its approach); else projected
 //     Gauss-Seidel where every update is the exact minimiser of the kinetic energy over its own
 //     block (normal: P_n >= 0; tangential: the disc |P_t| <= mu P_n, in the metric of W_tt), so
 //     every sweep lowers the energy; warm-started, symmetric sweeps, converged to 1e-11 of the
@@ -115,7 +115,7 @@ ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol);
 // point (compression plus restitution); `geometry`: the set-up shared with other solves of c at
 // s.R (see ContactGeometry). All optional. `direct`: a multi-point plastic solve
 // first tries the direct solves (every point sliding or lifting, then every point sticking;
-// friction_impact.cpp); false: always the Gauss-Seidel sweeps (the tests compare the two).
+// friction_impact.cpp; a curved die's only when every point slips past mu times its approach); false: always the Gauss-Seidel sweeps (the tests compare the two).
 ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,
                                    const ContactImpulses* warm = nullptr, ContactImpulses* out = nullptr,
                                    ContactGeometry* geometry = nullptr, bool direct = true);
