@@ -524,11 +524,11 @@ TEST(CylinderImpulse, CoinOnItsSideTwoPointSolveConverges) {
 // A cylinder's multi-point plastic solves by the direct solves (solve_sliding, solve_sticking;
 // tried when every point slips at least mu times its approach speed) against Gauss-Seidel's
 // converged solution of the same problem: a quarter-like coin and a thick one, on their side (the
-// two rims' lowest points) and on a face (its tripod), tilted by up to 1e-3 rad, fast and slow.
+// two rims' lowest points) and on a face (its tripod), slightly tilted, fast and slow.
 // Where a direct solve is accepted the velocities are the sweeps' to their tolerance and Coulomb's
 // law holds at every point; the direct path must be taken (it was not, for any cylinder, before).
 TEST(CylinderImpulse, RimDirectSolvesAreGaussSeidelsSolution) {
-  int accepted = 0, declined = 0, unconverged = 0;
+  int accepted = 0, declined = 0;
   double worst = 0.0;
   for (const double h : {0.00175, 0.0143}) {
     const DieModel m = coin_model(0.01213, h);
@@ -536,7 +536,9 @@ TEST(CylinderImpulse, RimDirectSolvesAreGaussSeidelsSolution) {
     for (int trial = 0; trial < 400; ++trial)
       for (const bool restitution : {false, true}) {
         const bool side = trial % 2 == 0;
-        const double tilt = 1e-3 * (2.0 * rng.uniform() - 1.0);
+        // Tilted as far as a contact set admits: a face's tripod within the touch tolerance (1e-7
+        // rad), a side's two rims within 1e-4 rad.
+        const double tilt = (side ? 1e-4 : 1e-7) * (2.0 * rng.uniform() - 1.0);
         const double turn = 6.283185307179586 * rng.uniform();
         // On its side: the axis (body z) horizontal; on a face: the axis vertical, heads or tails down.
         Mat3 R = (Eigen::AngleAxisd(turn, Vec3::UnitZ()) * Eigen::AngleAxisd(tilt, Vec3::UnitY())).toRotationMatrix();
@@ -569,14 +571,11 @@ TEST(CylinderImpulse, RimDirectSolvesAreGaussSeidelsSolution) {
             (direct.velocity - sweeps.velocity).norm() + (direct.omega - sweeps.omega).norm() * m.bounding_radius;
         worst = std::max(worst, dv / speed);
         EXPECT_LE(dv, 1e-8 * speed) << "h " << h << ", trial " << trial << ", restitution " << restitution;
-        // (With restitution, Gauss-Seidel's restitution phase on a tripod can stop unconverged on
-        // these random states, counted; the direct solves change only the compression.)
-        unconverged += rs.corrections.pgs_unconverged;
-        if (restitution) {
-          EXPECT_EQ(rd.corrections.pgs_unconverged, rs.corrections.pgs_unconverged) << trial;
-          continue;
-        }
-        EXPECT_EQ(rs.corrections.pgs_unconverged, 0u) << trial;
+        // (A tripod tilted by 1e-3 rad, its points 12 um apart in height, is out of one contact
+        // plane: there Gauss-Seidel's restitution phase stalled in 26 of 400 such impacts, as on
+        // polyhedral faces before their one-plane lever arms.)
+        EXPECT_FALSE(rs.corrections.any()) << trial;
+        if (restitution) continue;
         if (rd.iterations > 0) {  // both declined: the sweeps' own result, bit for bit
           ++declined;
           EXPECT_EQ(direct.velocity, sweeps.velocity) << trial;
@@ -597,9 +596,9 @@ TEST(CylinderImpulse, RimDirectSolvesAreGaussSeidelsSolution) {
   }
   EXPECT_GT(accepted, 100);
   EXPECT_GT(declined, 20);
-  std::printf("cylinder direct solves: %d accepted, %d declined; the sweeps unconverged in %d with restitution; worst "
-              "velocity difference from Gauss-Seidel %.2g of the speeds\n",
-              accepted, declined, unconverged, worst);
+  std::printf("cylinder direct solves: %d accepted, %d declined; worst velocity difference from Gauss-Seidel "
+              "%.2g of the speeds\n",
+              accepted, declined, worst);
 }
 
 // A quarter landing flat on its face (tilt ~1e-7 rad, falling at 0.1-0.3 m/s, turning at 10-60
