@@ -102,7 +102,8 @@ inline SinCos sincos_turns(double u) {
 
 // Two angles at once: the same numbers as {sincos(x), sincos(y)}, bit for bit (each lane does the
 // same IEEE operations in the same order), at about the cost of one with SSE2.
-inline void sincos2(double x, double y, SinCos& sx, SinCos& sy) {
+// (Forced inline: the torque-free rotation's hot path calls it, and GCC kept it out of line there.)
+[[gnu::always_inline]] inline void sincos2(double x, double y, SinCos& sx, SinCos& sy) {
 #if defined(__SSE2__)
   using namespace sincos_detail;
   if (!(std::abs(x) <= 1e6) || !(std::abs(y) <= 1e6)) {

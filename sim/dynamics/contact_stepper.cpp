@@ -184,7 +184,7 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   // curved die's support solve builds its own (rim_support: the rotation is part of its search).
   std::optional<TorqueFreeRotation>& slot = full ? full_rot_ : trial_rot_;
   const bool built = m.curved() && c.n > 0;
-  if (built) rim_support(s, c, d, mechanical_energy(m, s0), a, slot, full);
+  if (built) rim_support(s, c, d, e_start_, a, slot, full);
   if (!m.curved() && c.n > 0) {
     s.velocity.z() -= bias;
     a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
@@ -196,7 +196,7 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   const TorqueFreeRotation& rot = built                             ? *slot
                                   : !full && c.n == 0 && full_rot_ ? *full_rot_
                                                                     : slot.emplace(m.principal_moments, s.R,
-                                                                                   Vec3(Iw_start_ * s.omega));
+                                                                                   Vec3(Iw_start_ * s.omega), full);
   rot_start_ = s.R;
   const Vec3 p = s.position, v = s.velocity;
   // Every body point lies within the bounding radius of the COM (|bottom row| = 1 to rounding, far
@@ -227,7 +227,7 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   s.omega = w;
   if (!(bias > 0.0)) return true;
   // (New corners below the floor are the located step's business.)
-  return held_energy(s, c) <= mechanical_energy(m, s0) + m.mass * m.gravity * start_depth_max_;
+  return held_energy(s, c) <= e_start_ + m.mass * m.gravity * start_depth_max_;
 }
 
 namespace {
@@ -810,12 +810,16 @@ int FixedStepper::step(RigidState& s) {
   impact_ = false;
   geo_.valid = false;  // every solve of this step (its impact, each trial) shares s0.R and c
   Iw_start_ = world_inertia(m, s0.R);
+  // The solves' set-up needs the same world inertia (the same expression of the same R): handed over.
+  geo_.Iw = Iw_start_;
+  geo_.iw_given = true;
   if (c.n > 0) {
     double un = 0.0;
     for (int i = 0; i < c.n; ++i) un = std::min(un, corner_velocity(m, s0, c.vertex[i]).z());
     impact_ = un < -(v_impact_ + v_spin_ * s0.omega.squaredNorm());
     if (impact_) imp_ = apply_friction_impact(m, s0, c, /*restitution=*/true, nullptr, nullptr, &geo_);
   }
+  e_start_ = mechanical_energy(m, s0);  // after the impact: every trial's energy check starts here
   rims_new_ = false;
   slap_rims_ = 0;
   miss_rate_ = 0.0;

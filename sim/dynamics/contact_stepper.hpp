@@ -211,6 +211,7 @@ class FixedStepper {
   double dt_ = 0.0;
   Mat3 rot_start_ = Mat3::Identity();  // orientation at the start of the step being tried
   Mat3 Iw_start_ = Mat3::Identity();   // its world inertia (every trial's angular momentum)
+  double e_start_ = 0.0;                // its mechanical energy after the impact (the trials' checks)
   Attempt a_, b_, lo_;                  // trial steps (members: ContactImpulses is large)
   ContactImpulses warm_;  // the last plastic solve's impulses (warm start of the next)
   ContactGeometry geo_;   // the contact set-up of the current step (shared by its solves)

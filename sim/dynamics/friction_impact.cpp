@@ -1314,7 +1314,7 @@ void set_up_sweep_terms(ContactGeometry& geo) {
 
 // The part of a solve's set-up that depends only on the orientation R and the contact set.
 void set_up_geometry(const DieModel& m, const Body& b, const Mat3& R, const ContactSet& c, ContactGeometry& geo) {
-  geo.Iw = world_inertia(m, R);
+  if (!geo.iw_given) geo.Iw = world_inertia(m, R);
   geo.inv_inertia = b.inv_inertia;
   Points& pts = geo.pts;
   pts.n = c.n;

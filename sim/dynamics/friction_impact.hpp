@@ -93,6 +93,9 @@ struct ContactPoints {
 // clears `valid` whenever the orientation or the set changes.
 struct ContactGeometry {
   bool valid = false;
+  // Iw already holds world_inertia(m, R) (the caller computed it for the same R): the set-up
+  // keeps it. The caller clears it with `valid` when the orientation changes.
+  bool iw_given = false;
   Mat3 Iw = Mat3::Identity(), inv_inertia = Mat3::Identity();
   ContactPoints pts;
 };

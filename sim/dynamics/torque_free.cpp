@@ -131,7 +131,7 @@ bool is_symmetric_top(const Vec3& moments) {
          nearly_equal(moments[0], moments[2]);
 }
 
-TorqueFreeRotation::TorqueFreeRotation(const Vec3& moments, const Mat3& R0, const Vec3& L_world)
+TorqueFreeRotation::TorqueFreeRotation(const Vec3& moments, const Mat3& R0, const Vec3& L_world, bool bounds)
     : I_(moments), R0_(R0), L_(L_world) {
   if (L_.squaredNorm() == 0.0) {  // zero, or so small that |L|^2 underflows (omega ~ 0 anyway)
     kind_ = Kind::Still;
@@ -142,7 +142,7 @@ TorqueFreeRotation::TorqueFreeRotation(const Vec3& moments, const Mat3& R0, cons
              e02 = nearly_equal(I_[0], I_[2]);
   if (!(e01 || e12 || e02)) {  // not is_symmetric_top(I_)
     kind_ = Kind::General;
-    init_general(L_body);
+    init_general(L_body, bounds);
     return;
   }
   kind_ = Kind::SymmetricTop;
@@ -150,17 +150,18 @@ TorqueFreeRotation::TorqueFreeRotation(const Vec3& moments, const Mat3& R0, cons
   if (int(e01) + int(e12) + int(e02) >= 2) {
     // A sphere (all three agree): pure rotation about L at |L|/I; the axis choice is immaterial.
     const double a_mean = a.sum() / 3.0;
-    init_symmetric(2, a_mean, a_mean, L_body);
+    init_symmetric(2, a_mean, a_mean, L_body, bounds);
   } else if (e01) {
-    init_symmetric(2, a[2], 0.5 * (a[0] + a[1]), L_body);
+    init_symmetric(2, a[2], 0.5 * (a[0] + a[1]), L_body, bounds);
   } else if (e12) {
-    init_symmetric(0, a[0], 0.5 * (a[1] + a[2]), L_body);
+    init_symmetric(0, a[0], 0.5 * (a[1] + a[2]), L_body, bounds);
   } else {
-    init_symmetric(1, a[1], 0.5 * (a[0] + a[2]), L_body);
+    init_symmetric(1, a[1], 0.5 * (a[0] + a[2]), L_body, bounds);
   }
 }
 
-void TorqueFreeRotation::init_symmetric(int axis, double inv_I_axis, double inv_I_perp, const Vec3& L_body) {
+void TorqueFreeRotation::init_symmetric(int axis, double inv_I_axis, double inv_I_perp, const Vec3& L_body,
+                                        bool bounds) {
   Symmetric& s = sym_;
   s.axis = axis;
   s.p = (axis + 1) % 3;
@@ -174,6 +175,7 @@ void TorqueFreeRotation::init_symmetric(int axis, double inv_I_axis, double inv_
   s.along = L_hat * (L_hat.transpose() * R0_);
   s.across = R0_ - s.along;
   for (int j = 0; j < 3; ++j) s.cross.col(j) = L_hat.cross(R0_.col(j));  // [L^]x R0
+  if (!bounds) return;
 
   // |omega| and |alpha| are constant in regular precession: omega_world = a_perp L + spin_rate R e_a,
   // d(R e_a)/dt = a_perp L x R e_a, so |alpha| = |spin_rate| a_perp |L x e_a| = |spin_rate| a_perp L_perp.
@@ -186,7 +188,7 @@ void TorqueFreeRotation::init_symmetric(int axis, double inv_I_axis, double inv_
   max_alpha_ = alpha * (1.0 + kBoundMargin) + kBoundMargin * a_max * L_norm * max_omega_;
 }
 
-void TorqueFreeRotation::init_general(const Vec3& L_body) {
+void TorqueFreeRotation::init_general(const Vec3& L_body, bool bounds) {
   General& g = gen_;
   g.inv_I = I_.cwiseInverse();
   const Vec3& a = g.inv_I;
@@ -196,7 +198,7 @@ void TorqueFreeRotation::init_general(const Vec3& L_body) {
   for (int i = 0; i < 3; ++i) {
     if (L_body[(i + 1) % 3] == 0.0 && L_body[(i + 2) % 3] == 0.0) {
       g.steady = true;
-      init_symmetric(i, a[i], a[i], L_body);
+      init_symmetric(i, a[i], a[i], L_body, bounds);
       return;
     }
   }
@@ -295,6 +297,7 @@ void TorqueFreeRotation::init_general(const Vec3& L_body) {
   const Mat3 B0 = general_orientation(start, 0.0, nullptr);  // = B(0) while frame is the identity
   g.frame = R0_ * B0.transpose();
 
+  if (!bounds) return;
   // Bounds. Along the orbit s = sn^2 runs over [0, 1] and L_c^2 = P^2 (1 - s), L_m^2 = Q^2 s,
   // L_d^2 = D^2 (k'^2 + k^2 (1 - s)). |omega|^2 is linear in s: its sup is at an end.
   const double Q2 = sq(g.Q);

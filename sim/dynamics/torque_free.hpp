@@ -14,8 +14,10 @@ class TorqueFreeRotation {
  public:
   TorqueFreeRotation() = default;
   // moments: principal moments (ascending, > 0); R0: principal->world rotation at t = 0;
-  // L_world: angular momentum in world coordinates (constant).
-  TorqueFreeRotation(const Vec3& moments, const Mat3& R0, const Vec3& L_world);
+  // L_world: angular momentum in world coordinates (constant). bounds: whether max_omega() and
+  // max_alpha() are computed (false: both 0; a trial step's rotation never asks, and they cost
+  // a fair share of the set-up).
+  TorqueFreeRotation(const Vec3& moments, const Mat3& R0, const Vec3& L_world, bool bounds = true);
 
   // Orientation (principal->world) at time t >= 0 after the start.
   Mat3 orientation(double t) const;
@@ -88,8 +90,8 @@ class TorqueFreeRotation {
     double sn, cn, dn;  // at u = lambda t + u0
     double f;           // precession integral f(u) (see torque_free.cpp)
   };
-  void init_symmetric(int axis, double inv_I_axis, double inv_I_perp, const Vec3& L_body);
-  void init_general(const Vec3& L_body);
+  void init_symmetric(int axis, double inv_I_axis, double inv_I_perp, const Vec3& L_body, bool bounds);
+  void init_general(const Vec3& L_body, bool bounds);
   JacobiState jacobi_state(double t) const;
   Mat3 symmetric_orientation(double t) const;
   Mat3 general_orientation(const JacobiState& js, double t, Vec3* L_body) const;
