@@ -611,6 +611,26 @@ TEST(CylinderImpulse, FaceLandingFlatStrikesItsTripod) {
   expect_quarter_tosses_unlifted({1568u, 2977u, 4170u, 19608u});
 }
 
+// A near-flat coin spinning fast: the rim's lowest point runs round the rim, its height far from
+// quadratic over the step, and the curvature impulse's target for the exact end gap lies above the
+// point's reflection, so the impulse's own work gains (kind B of issue 13; not gravity's share of
+// a rolling coin, kind A). It was capped and counted as an energy clamp; now the step is halved
+// (unreflected, contact_stepper.cpp) and holds the rims without gaining. Tosses of
+// scenes/coins/quarter.toml (`impulse`, seed 1) that each clamped once on 470a8b3 (its other
+// clamping toss in the first 4000, 3259, still clamps after the halvings).
+TEST(CylinderImpulse, NearFlatCurvatureImpulseIsHalvedNotClamped) {
+  const DieModel m =
+      compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter.toml", {"sim.fidelity=\"impulse\""}));
+  for (const std::uint64_t i : {312u, 695u, 954u, 2509u, 3289u}) {
+    TossProbe probe;
+    const TossResult r = toss(m, 1, i, &probe);
+    EXPECT_EQ(r.corrections.energy_clamps, 0u) << i;
+    EXPECT_EQ(r.corrections.overlap_fixes, 0u) << i;
+    EXPECT_GE(probe.halved, 1u) << i;
+    EXPECT_LE(probe.max_energy_gain, 1e-12) << i;
+  }
+}
+
 // The quarter that lands spinning upright about the vertical (2.4 % of quarter-table's `impulse`
 // tosses did, and stood there for 15-22 s): it rocks from rim to rim, rolling on each, and as the
 // spin slows the rocking grows until it leaves the band (+-3.2 deg of upright, where the COM is
@@ -656,6 +676,22 @@ TEST(CylinderPaperAndStepped, TossesSettleAndReadTheRimsModel) {
   // Corrections happen (counted, reported): since the rims are kept on the floor, the lifts of a
   // slapping rim (overlap_fixes, contact_stepper.cpp rim_support), in 6 of these 40 tosses.
   EXPECT_LE(stepped.corrections, 8);
+}
+
+// The same at `stepped`'s contact step: the three-sided coin's (scenes/coins/three-sided-coin.toml,
+// seed 1) only energy clamps in 3000 tosses on 470a8b3, each a near-flat curvature impulse whose own
+// work gained; halved now, not clamped.
+TEST(CylinderStepped, NearFlatCurvatureImpulseIsHalvedNotClamped) {
+  const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/three-sided-coin.toml",
+                                        {"sim.fidelity=\"stepped\""}));
+  for (const std::uint64_t i : {869u, 1829u}) {
+    TossProbe probe;
+    const TossResult r = toss(m, 1, i, &probe);
+    EXPECT_EQ(r.corrections.energy_clamps, 0u) << i;
+    EXPECT_EQ(r.corrections.overlap_fixes, 0u) << i;
+    EXPECT_GE(probe.halved, 1u) << i;
+    EXPECT_LE(probe.max_energy_gain, 1e-12) << i;
+  }
 }
 
 // Rest soundness: when `impulse` says settled, continued contact dynamics never name another

@@ -90,7 +90,7 @@ class FixedStepper {
   std::uint64_t curvature_impulses = 0;  // curved dice: mid-step curvature impulses (rim_support)
   std::uint64_t curvature_capped = 0;    // ... of them capped to gain no energy
   std::uint64_t start_capped = 0;        // curved dice: start solves capped to gain no energy (energy_clamps)
-  std::uint64_t halved = 0;              // curved dice: steps halved because the cap left them sinking
+  std::uint64_t halved = 0;              // curved dice: steps halved because the cap left them sinking (or unreflected)
   std::uint64_t slaps = 0;               // curved dice: steps shortened to a slapping face's arrival
   // Curved dice: the slap's two re-decisions (step()): the plain step taken because a slap's far
   // half does not reach the floor within the full step, and the plain step's search run again
@@ -125,6 +125,10 @@ class FixedStepper {
     double G = 0.0;  // lowest height at the step's end over corners not in c
     bool capped = false;  // curved: the curvature impulse was capped and left the rims below the floor
     bool clamped = false; // curved: the curvature impulse was capped (to gain no energy) at all
+    // curved: capped because its own kinetic work would gain (its target above the point's
+    // reflection: the lowest point's height far from quadratic over the step); the step is halved
+    // (step()), and a clamp counted only if the halvings do not remove it
+    bool unreflected = false;
     bool risen = false;   // flat: the held corners were asked to rise (try_step); else the plain solve
     bool rise_dropped = false;  // flat: they could not be without gaining energy (the plain solve instead)
   };
