@@ -156,12 +156,20 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   // g^2 d^2 / 2) (m_eff = 1 / W_nn), so b = g d costs energy only where m_eff > 3 m / 4 (a corner
   // nearly under the COM). Checked at the step's end: if it gains, b / 4, then none: the plain
   // step, which never gains kinetic + m g z (counted, rise_dropped; its corners' depth stays).
+  if (full) full_bias_ = 0.0;
   if (!hold_ || m.curved() || c.n == 0) {
     try_step_with(s0, c, d, a, full, 0.0);
     return;
   }
   const double b = std::min(start_shallow_ / d + 0.5 * a_down_ * d, m.gravity * d);
-  if (try_step_with(s0, c, d, a, full, b) || try_step_with(s0, c, d, a, full, 0.25 * b)) return;
+  if (try_step_with(s0, c, d, a, full, b)) {
+    if (full) full_bias_ = b;
+    return;
+  }
+  if (try_step_with(s0, c, d, a, full, 0.25 * b)) {
+    if (full) full_bias_ = 0.25 * b;
+    return;
+  }
   try_step_with(s0, c, d, a, full, 0.0);
   a.rise_dropped = true;
 }
@@ -505,9 +513,17 @@ Mat3 skew_of(const Vec3& r) {
 // -g e_z per unit length. W_ij = I/m - [r_i]x I_w^-1 [r_j]x, the points' compliance blocks. False
 // if the system has no solution to 1e-9 (a sticking edge's or face's impulses are not unique, but
 // then any solution gives the same motion, and the residual accepts it).
+//
+// Also the second derivative (dF2, dM2): the same matrix (the regime's equations are linear in
+// the impulses but for a sliding point's friction direction d = s / |s|, s its slip after the
+// solve), its right side the direction's curvature along the first derivative: with x the slip's
+// rate, the sliding rows P_t + mu P_n d = 0 twice differentiated give
+// A P'' = -mu (2 P'_n x_perp / |s| - P_n (2 (d.x) x_perp + |x_perp|^2 d) / |s|^2), x_perp = x - (d.x) d
+// (the kick is linear in the step length, so the normal rows' right side is 0).
 template <int K>
 bool support_derivative(const ContactPoints& pts, const Mat3& Iinv, double mass, double g, const Vec3& v,
-                        const Vec3& w, const ContactImpulses& P, double speed, Vec3& dF, Vec3& dM) {
+                        const Vec3& w, const ContactImpulses& P, double speed, Vec3& dF, Vec3& dM, Vec3& dF2,
+                        Vec3& dM2) {
   constexpr int N = 3 * K;
   Eigen::Matrix<double, N, N> A = Eigen::Matrix<double, N, N>::Zero();
   Eigen::Matrix<double, N, 1> b = Eigen::Matrix<double, N, 1>::Zero();
@@ -544,7 +560,8 @@ bool support_derivative(const ContactPoints& pts, const Mat3& Iinv, double mass,
     A(3 * i, 3 * i + 2) += pts.mu[i] * dir.x();
     A(3 * i + 1, 3 * i + 2) += pts.mu[i] * dir.y();
   }
-  const Eigen::Matrix<double, N, 1> x = A.partialPivLu().solve(b);
+  const Eigen::PartialPivLU<Eigen::Matrix<double, N, N>> lu = A.partialPivLu();
+  const Eigen::Matrix<double, N, 1> x = lu.solve(b);
   if (!x.allFinite() || !((A * x - b).norm() <= 1e-9 * b.norm())) return false;
   dF.setZero();
   dM.setZero();
@@ -552,6 +569,32 @@ bool support_derivative(const ContactPoints& pts, const Mat3& Iinv, double mass,
     const Vec3 Pj = x.template segment<3>(3 * j);
     dF += Pj;
     dM += pts.r[j].cross(Pj);
+  }
+  const Vec3 dw = Iinv * dM;
+  Eigen::Matrix<double, N, 1> b2 = Eigen::Matrix<double, N, 1>::Zero();
+  for (int i = 0; i < K; ++i) {
+    const Vec3& Pi = P.P[i];
+    const Vec3 u = v + w.cross(pts.r[i]);
+    const Eigen::Vector2d slip(u.x(), u.y());
+    const double sn = slip.norm();
+    if (!(Pi.z() > 0.0) || sn <= 1e-9 * speed) continue;  // no impulse, or sticking: linear
+    const Vec3 du = dF / mass + dw.cross(pts.r[i]);
+    const Eigen::Vector2d dir = slip / sn, xs(du.x(), du.y());
+    const double dx = dir.dot(xs);
+    const Eigen::Vector2d xp = xs - dx * dir;
+    const Eigen::Vector2d r2 =
+        -pts.mu[i] * (2.0 * x(3 * i + 2) * xp / sn - Pi.z() * (2.0 * dx * xp + xp.squaredNorm() * dir) / (sn * sn));
+    b2(3 * i) = r2.x();
+    b2(3 * i + 1) = r2.y();
+  }
+  dF2.setZero();
+  dM2.setZero();
+  const Eigen::Matrix<double, N, 1> y = lu.solve(b2);
+  if (!y.allFinite()) return true;
+  for (int j = 0; j < K; ++j) {
+    const Vec3 Pj = y.template segment<3>(3 * j);
+    dF2 += Pj;
+    dM2 += pts.r[j].cross(Pj);
   }
   return true;
 }
@@ -574,22 +617,37 @@ double FixedStepper::predicted_miss(const ContactSet& c, const Vec3& r) {
   const int k = c.n;
   if (m.curved() || k == 0 || k > 4 || a_.next.n != k) return 0.0;
   const double g = m.gravity;
+  // The solve sees the pre-solve normal velocity shifted by the kick g d and the held corners'
+  // rise b(d) (try_step): per unit step length g + b'. With no depth at the start b is linear in
+  // d (b = d k min(a_n / 2, g)), so b' = b(h) / h exactly for the full step's branch k.
+  const double kick_rate = g + (start_shallow_ > 0.0 ? 0.0 : full_bias_ / h_);
   const double speed = full_v_.norm() + full_w_.norm() * m.bounding_radius + 1e-2 * std::sqrt(g * m.bounding_radius);
-  Vec3 dF, dM;
+  Vec3 dF, dM, dF2, dM2;
   bool ok = false;
   switch (k) {
-    case 1: ok = support_derivative<1>(geo_.pts, geo_.inv_inertia, m.mass, g, full_v_, full_w_, a_.next, speed, dF, dM); break;
-    case 2: ok = support_derivative<2>(geo_.pts, geo_.inv_inertia, m.mass, g, full_v_, full_w_, a_.next, speed, dF, dM); break;
-    case 3: ok = support_derivative<3>(geo_.pts, geo_.inv_inertia, m.mass, g, full_v_, full_w_, a_.next, speed, dF, dM); break;
-    default: ok = support_derivative<4>(geo_.pts, geo_.inv_inertia, m.mass, g, full_v_, full_w_, a_.next, speed, dF, dM); break;
+    case 1: ok = support_derivative<1>(geo_.pts, geo_.inv_inertia, m.mass, kick_rate, full_v_, full_w_, a_.next, speed, dF, dM, dF2, dM2); break;
+    case 2: ok = support_derivative<2>(geo_.pts, geo_.inv_inertia, m.mass, kick_rate, full_v_, full_w_, a_.next, speed, dF, dM, dF2, dM2); break;
+    case 3: ok = support_derivative<3>(geo_.pts, geo_.inv_inertia, m.mass, kick_rate, full_v_, full_w_, a_.next, speed, dF, dM, dF2, dM2); break;
+    default: ok = support_derivative<4>(geo_.pts, geo_.inv_inertia, m.mass, kick_rate, full_v_, full_w_, a_.next, speed, dF, dM, dF2, dM2); break;
   }
   if (!ok) return 0.0;
   const Vec3 dw = geo_.inv_inertia * dM;
   const double miss = -(dF.z() / m.mass) - dw.cross(r).z();
-  const double rate = -0.5 * dw.cross(full_w_.cross(r)).z();
-  if (!std::isfinite(miss) || !std::isfinite(rate)) return 0.0;
-  miss_rate_ = rate;
-  return miss;
+  // The rotation's part to second order in t: the trial's orientation differs by dtheta(t) =
+  // t dw + t^2 / 2 (w x dw + dalpha) (per unit of -(h - d)), the lever turns as r + t w x r, so the
+  // height's t^2 term is (dw x (w x r) + (w x dw) x r / 2 + dalpha x r / 2)_z = (dw x (w x r) + w x
+  // (dw x r) + dalpha x r)_z / 2 (Jacobi), dalpha the torque-free acceleration's change,
+  // -I_w^-1 (dw x L + w x I_w dw), L = I_w w.
+  const Vec3& w = full_w_;
+  const Vec3 L = geo_.Iw * w;
+  const Vec3 dalpha = -(geo_.inv_inertia * (dw.cross(L) + w.cross(geo_.Iw * dw)));
+  const double rate = -0.5 * (dw.cross(w.cross(r)) + w.cross(dw.cross(r)) + dalpha.cross(r)).z();
+  // The solve's second order: G - model_G gains d (h - d)^2 (F''_z / m + (w'' x r)_z) / 2, i.e.
+  // the coefficient c2 (h - t) on top of miss + rate t: folded into both.
+  const double c2 = 0.5 * (dF2.z() / m.mass + (geo_.inv_inertia * dM2).cross(r).z());
+  if (!std::isfinite(miss) || !std::isfinite(rate) || !std::isfinite(c2)) return 0.0;
+  miss_rate_ = rate - c2;
+  return miss + c2 * h_;
 }
 
 double FixedStepper::hermite_start(double miss, double lo, double hi, double x) const {

@@ -224,6 +224,10 @@ class FixedStepper {
   Vec3 full_p_ = Vec3::Zero(), full_v_ = Vec3::Zero();
   Vec3 full_w_ = Vec3::Zero();
   double miss_rate_ = 0.0;
+  // The held corners' rise the full step's solve was asked for (m/s: b, b / 4 or 0, try_step):
+  // with no depth at the start it is linear in the step length, and the shortened steps' solves
+  // see the kick g d plus it (predicted_miss).
+  double full_bias_ = 0.0;
   bool hermite_ = false;  // hq_ holds the arriving corner's height and rate at t = 0 and h
   double hq_[4] = {0.0, 0.0, 0.0, 0.0};  // the corrected model's miss grows by this per unit t (predicted_miss)  // the full step's angular velocity after its support solve
   // A curved die whose touching rims the support solve does not push (their material points leave
