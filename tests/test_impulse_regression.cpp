@@ -58,6 +58,10 @@
 // 42499 -> 44335 / 43885 / 44954 / 42498, `stepped` 2020 / 2144 -> 2018 / 2148 (Dice 1, 2); no face.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
+#include <utility>
+
 #include <string>
 
 #include "fidelity_test_util.hpp"
@@ -73,10 +77,10 @@ using dicesim::testing::Golden;
 
 TEST(ImpulseRegression, CountsArePinned) {
   const Golden golden[] = {
-      {"scenes/paper/die1.toml", {300, 307, 288, 307, 195, 603}, 33000, {0, 0, 0, 0}},
-      {"scenes/paper/die2.toml", {360, 297, 324, 303, 286, 430}, 33181, {0, 0, 0, 0}},
-      {"scenes/paper/die3.toml", {201, 461, 303, 323, 478, 234}, 33693, {0, 0, 0, 0}},
-      {"scenes/fair.toml", {319, 332, 348, 338, 307, 356}, 32078, {0, 0, 0, 0}},
+      {"scenes/paper/die1.toml", {300, 307, 288, 307, 195, 603}, 32992, {0, 0, 0, 0}},
+      {"scenes/paper/die2.toml", {360, 297, 324, 303, 286, 430}, 33187, {0, 0, 0, 0}},
+      {"scenes/paper/die3.toml", {201, 461, 303, 323, 478, 234}, 33687, {0, 0, 0, 0}},
+      {"scenes/fair.toml", {319, 332, 348, 338, 307, 356}, 32072, {0, 0, 0, 0}},
   };
   for (const Golden& g : golden) check_pinned(g, Fidelity::Impulse, 2000);
 }
@@ -89,26 +93,35 @@ TEST(ImpulseRegression, CountsArePinned) {
 // The support solve linearised in the step length (predicted_miss) puts the first trial within
 // the tolerance in most of them: 1.20 (census at 2 000 tosses). The bound below fails with the
 // prediction switched off (predicted_miss returning 0: 1.61 on these 200 tosses).
-// At 1 ms: at the default 3 ms the first trial misses more often, 1.77 trials per located step
-// (1.78 with the held corners' rise off: the linearised miss is less accurate over a longer step).
+// At the default 3 ms the first-order prediction missed more often, 1.77 trials per located step:
+// over the longer step the support solve's second order (a sliding corner's friction direction
+// turns with the kick), the held corners' rise (the solve sees the kick plus the rise, b(d) linear
+// in d) and the rotation's t^2 term matter. With them the first trial lands in 58 % of one-corner
+// located steps (28 % before), 1.50 trials per located step (1.69 before; 1 000 tosses). Both
+// step lengths are checked here; the 3 ms bound fails on the first-order prediction.
 TEST(ImpulseStepper, LocatedStepsMostlyLandOnTheirFirstTrial) {
-  const DieModel m = compile(dicesim::testing::with_fidelity(
-      load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/paper/die1.toml", {"sim.contact_step=1e-3"}),
-      Fidelity::Impulse));
-  TossProbe probe;
-  for (int i = 0; i < 200; ++i) toss(m, 7, static_cast<std::uint64_t>(i), &probe);
-  ASSERT_GT(probe.located_steps, 1000u);
-  const double per_step = static_cast<double>(probe.located_trials) / static_cast<double>(probe.located_steps);
-  EXPECT_LT(per_step, 1.3) << probe.located_trials << " trials, " << probe.located_steps << " located steps";
-  EXPECT_GE(per_step, 1.0);
+  for (const auto& [step, bound] : {std::pair{"1e-3", 1.3}, std::pair{"3e-3", 1.6}}) {
+    const DieModel m = compile(dicesim::testing::with_fidelity(
+        load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/paper/die1.toml",
+                   {std::string("sim.contact_step=") + step}),
+        Fidelity::Impulse));
+    TossProbe probe;
+    for (int i = 0; i < 200; ++i) toss(m, 7, static_cast<std::uint64_t>(i), &probe);
+    ASSERT_GT(probe.located_steps, 1000u);
+    const double per_step = static_cast<double>(probe.located_trials) / static_cast<double>(probe.located_steps);
+    EXPECT_LT(per_step, bound) << step << " s: " << probe.located_trials << " trials, " << probe.located_steps
+                               << " located steps";
+    EXPECT_GE(per_step, 1.0);
+    std::printf("contact_step %s s: %.3f trials per located step\n", step, per_step);
+  }
 }
 
 TEST(SteppedRegression, CountsArePinned) {
   const Golden golden[] = {
-      {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2020, {0, 0, 0, 0}},
-      {"scenes/paper/die2.toml", {15, 15, 21, 16, 16, 17}, 2149, {0, 0, 0, 0}},
-      {"scenes/paper/die3.toml", {14, 19, 14, 22, 21, 10}, 1987, {0, 0, 0, 0}},
-      {"scenes/fair.toml", {13, 16, 14, 16, 25, 16}, 2087, {0, 0, 0, 0}},
+      {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2017, {0, 0, 0, 0}},
+      {"scenes/paper/die2.toml", {15, 15, 21, 16, 16, 17}, 2148, {0, 0, 0, 0}},
+      {"scenes/paper/die3.toml", {14, 19, 14, 22, 21, 10}, 1989, {0, 0, 0, 0}},
+      {"scenes/fair.toml", {13, 16, 14, 16, 25, 16}, 2086, {0, 0, 0, 0}},
   };
   for (const Golden& g : golden) check_pinned(g, Fidelity::Stepped, 100);
 }
