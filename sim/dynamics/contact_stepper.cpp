@@ -1110,7 +1110,7 @@ int FixedStepper::step(RigidState& s) {
   const auto halve_while_capped = [&] {
     Attempt* buf = done == &b_ ? &lo_ : &b_;
     double d = dt;
-    for (int k = 0; k < kMaxHalvings && (done->capped || done->unreflected); ++k) {
+    for (int k = 0; k < kMaxHalvings && done->to_halve(); ++k) {
       d *= 0.5;
       try_step(s0, c, d, *buf);
       done = buf;
@@ -1121,14 +1121,14 @@ int FixedStepper::step(RigidState& s) {
   };
   // A slap's step whose near half the capped curvature impulse leaves sinking: halved as a plain
   // step would be, still a slap's (its end then before the far half's arrival).
-  if (slap_rims_ != 0 && (done->capped || done->unreflected)) halve_while_capped();
+  if (slap_rims_ != 0 && done->to_halve()) halve_while_capped();
   if (slap_rims_ != 0 && done->s.position.z() + rim_lowest(m, done->s.R) < -touch_tol_) {
     ++slap_rim_below;
     slap_rims_ = 0;
     try_step(s0, c, h_, a_, /*full=*/true);
     locate();
   }
-  if (m.curved() && (done->capped || done->unreflected) && slap_rims_ == 0) {
+  if (m.curved() && done->to_halve() && slap_rims_ == 0) {
     // (Not a slap's step: its end is the far half's arrival, which a halving would miss.)
     // The curvature impulse could not hold the rims on the floor without gaining energy: the
     // lowest point's height is far from quadratic over the step (a near-flat coin spinning fast,

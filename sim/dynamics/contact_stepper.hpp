@@ -129,6 +129,7 @@ class FixedStepper {
     // reflection: the lowest point's height far from quadratic over the step); the step is halved
     // (step()), and a clamp counted only if the halvings do not remove it
     bool unreflected = false;
+    bool to_halve() const { return capped || unreflected; }  // step() halves it (halve_while_capped)
     bool risen = false;   // flat: the held corners were asked to rise (try_step); else the plain solve
     bool rise_dropped = false;  // flat: they could not be without gaining energy (the plain solve instead)
   };

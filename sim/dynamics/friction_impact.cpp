@@ -1443,8 +1443,8 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
     // else the sweeps. Each answer is kept only where Coulomb's law verifies at every point, so
     // which solve runs first changes the cost, not the law. A cylinder's rim points try them only
     // when every point slips faster than mu times its approach: slower, a rolling rim's points
-    // stick, the sliding iteration runs out without converging (85 000 times in 200 tosses of
-    // the three-sided coin), and the sweeps, warm-started, solve sticking rims faster than
+    // stick, the sliding iteration runs out without converging (133 317 of 135 898 tries in 300
+    // tosses of the three-sided coin), and the sweeps, warm-started, solve sticking rims faster than
     // solve_sticking's 6x6 factorisation. (Polyhedra keep the unconditional order: their pins.)
     solved = solve_sliding(b, pts, speed, lever, pn, pt);
     if (!solved) solved = solve_sticking(b, Iw, pts, lever, pn, pt);

@@ -94,7 +94,7 @@ struct ContactPoints {
 struct ContactGeometry {
   bool valid = false;
   // Iw already holds world_inertia(m, R) (the caller computed it for the same R): the set-up
-  // keeps it. The caller clears it with `valid` when the orientation changes.
+  // keeps it. A caller that sets it stores Iw anew with every orientation (FixedStepper::step).
   bool iw_given = false;
   Mat3 Iw = Mat3::Identity(), inv_inertia = Mat3::Identity();
   ContactPoints pts;
@@ -116,9 +116,10 @@ ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol);
 // Coulomb friction. Updates s.velocity and s.omega; positions are untouched. `warm`: impulses of
 // a previous solve (matched by vertex) to start the compression from; `out`: the impulse at every
 // point (compression plus restitution); `geometry`: the set-up shared with other solves of c at
-// s.R (see ContactGeometry). All optional. `direct`: a multi-point plastic solve
-// first tries the direct solves (every point sliding or lifting, then every point sticking;
-// friction_impact.cpp; a curved die's only when every point slips past mu times its approach); false: always the Gauss-Seidel sweeps (the tests compare the two).
+// s.R (see ContactGeometry). All optional. `direct`: a multi-point plastic solve first tries the
+// direct solves (every point sliding or lifting, then every point sticking; friction_impact.cpp;
+// a curved die's only when every point slips past mu times its approach); false: always the
+// Gauss-Seidel sweeps (the tests compare the two).
 ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,
                                    const ContactImpulses* warm = nullptr, ContactImpulses* out = nullptr,
                                    ContactGeometry* geometry = nullptr, bool direct = true);
