@@ -626,6 +626,32 @@ TEST(CylinderImpulse, FaceLandingFlatStrikesItsTripod) {
   expect_quarter_tosses_unlifted({1568u, 2977u, 4170u, 19608u});
 }
 
+// A coin landing or lying nearly flat (tilt 1e-6 to 6e-5 rad) whose contact set is one rim point:
+// its rim's lowest point runs round the near half while the face comes down, so a slap's located
+// step left the rest of the rim below the floor, or the curvature impulse stayed capped after the
+// halvings (a plain step's, not a slap), and the rim was lifted, 0.02-30 um. Now such a step is
+// taken again with the face's tripod struck when it reaches the floor within the step or lies
+// that close (lands_flat, contact_stepper.cpp). Every toss here clamped and lifted before (quarter
+// `impulse`: all six of 2e4, seed 1; quarter-table: its only lift in 2e4); none now, and each
+// took the tripod path.
+TEST(CylinderImpulse, NearlyFlatFaceLandingIsStruckNotLifted) {
+  const auto check = [](const char* scene, std::initializer_list<std::uint64_t> tosses) {
+    const DieModel m =
+        compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/" + scene, {"sim.fidelity=\"impulse\""}));
+    for (const std::uint64_t i : tosses) {
+      TossProbe probe;
+      const TossResult r = toss(m, 1, i, &probe);
+      EXPECT_EQ(r.corrections.energy_clamps, 0u) << scene << " " << i;
+      EXPECT_EQ(r.corrections.overlap_fixes, 0u) << scene << " " << i;
+      EXPECT_EQ(r.corrections.pgs_unconverged, 0u) << scene << " " << i;
+      EXPECT_GE(probe.flat_landed, 1u) << scene << " " << i;
+      EXPECT_LE(probe.max_energy_gain, 1e-12) << scene << " " << i;
+    }
+  };
+  check("quarter.toml", {3259u, 6927u, 10377u, 10420u, 19432u});
+  check("quarter-table.toml", {16450u});
+}
+
 // A near-flat coin spinning fast: the rim's lowest point runs round the rim, its height far from
 // quadratic over the step, and the curvature impulse's target for the exact end gap lies above the
 // point's reflection, so the impulse's own work gains (kind B of issue 13; not gravity's share of

@@ -788,7 +788,7 @@ long long FixedStepper::coast(RigidState& s, double& t, double max_time, long lo
   return static_cast<long long>(k);
 }
 
-void FixedStepper::add_face_tripod(const RigidState& s, ContactSet& c) const {
+void FixedStepper::add_face_tripod(const RigidState& s, ContactSet& c, double window, double depth) const {
   // A coin flat to within ~1e-7 rad (a slap's located end: the far half arrives as the tilt
   // passes zero) touches with its whole face, but the features 120 deg either side of the rim's
   // lowest point sit 1.5 a tilt above it, just outside the touch tolerance: the contact set was the
@@ -796,8 +796,14 @@ void FixedStepper::add_face_tripod(const RigidState& s, ContactSet& c) const {
   // impulse could not hold it without gaining energy (capped, halved four times) and it was
   // lifted. The face's tripod joins the set when its features are within the impulse model's
   // strike tolerance (1e-6 r, corners that close strike together), as a polyhedron's face does.
+  // step() may widen that (lands_flat): each within `depth`, or reaching the floor within
+  // `window` at its approach speed.
   const DieModel& m = *m_;
   const double face_tol = 1e-6 * m.bounding_radius;
+  const auto joins = [&](int f) {
+    const double z = corner_height(m, s, f);
+    return z <= face_tol || z <= depth || z <= -window * corner_velocity(m, s, f).z();
+  };
   const int n0 = c.n;
   for (int r = 0; r < 2; ++r) {
     bool low = false, in1 = false, in2 = false;
@@ -807,7 +813,7 @@ void FixedStepper::add_face_tripod(const RigidState& s, ContactSet& c) const {
       in2 = in2 || c.vertex[i] == 3 * r + 2;
     }
     if (!low || (in1 && in2)) continue;
-    if (corner_height(m, s, 3 * r + 1) > face_tol || corner_height(m, s, 3 * r + 2) > face_tol) continue;
+    if (!joins(3 * r + 1) || !joins(3 * r + 2)) continue;
     if (!in1 && c.n < kMaxContacts) c.vertex[c.n++] = 3 * r + 1;
     if (!in2 && c.n < kMaxContacts) c.vertex[c.n++] = 3 * r + 2;
   }
@@ -869,7 +875,9 @@ int FixedStepper::step(RigidState& s) {
   const DieModel& m = *m_;
   ContactSet c;
   if (s.position.z() <= m.bounding_radius + touch_tol_) c = touching_corners(m, s, touch_tol_);
-  if (m.curved() && c.n > 0) add_face_tripod(s, c);
+  const bool relanded = land_window_ > 0.0 || land_depth_ > 0.0;
+  if (m.curved() && c.n > 0) add_face_tripod(s, c, land_window_, land_depth_);
+  land_window_ = land_depth_ = 0.0;
   const double E0 = mechanical_energy(m, s);
   // Impact first, at the instant of contact, on the velocity before gravity's kick: restitution
   // returns the approach speed the corner really had (after the kick it would return g h more,
@@ -1119,10 +1127,34 @@ int FixedStepper::step(RigidState& s) {
     }
     ++halved;
   };
+  // A coin so nearly flat that its face lands within `window`: its tripod reaches the floor within
+  // it at its approach speed (add_face_tripod). Then the step is taken again from the start with
+  // the tripod in the contact set, struck at once as a polyhedron's landing face is (the gap it
+  // leaves is what the tripod would close within the window), instead of a step whose rim the
+  // curvature impulse could not hold (below). Once per step.
+  const auto lands_flat = [&](double window, double depth) {
+    if (relanded) return false;
+    ContactSet wide = c;
+    add_face_tripod(s, wide, window, depth);
+    if (wide.n == c.n) return false;
+    land_window_ = window;
+    land_depth_ = depth;
+    return true;
+  };
   // A slap's step whose near half the capped curvature impulse leaves sinking: halved as a plain
   // step would be, still a slap's (its end then before the far half's arrival).
   if (slap_rims_ != 0 && done->to_halve()) halve_while_capped();
   if (slap_rims_ != 0 && done->s.position.z() + rim_lowest(m, done->s.R) < -touch_tol_) {
+    // A coin so nearly flat that its rim's lowest point runs round the near half while the far
+    // half comes down: the face is landing. If its tripod reaches the floor within the located
+    // step, the step is taken again with the tripod in the contact set (struck at once, as a
+    // polyhedron's face; it would be within dt anyway), not as the plain step, whose search
+    // cannot see the far half and whose capped curvature impulse left the rim to be lifted.
+    if (lands_flat(dt, 0.0)) {
+      ++slap_rim_below;
+      ++flat_landed;
+      return step(s);
+    }
     ++slap_rim_below;
     slap_rims_ = 0;
     try_step(s0, c, h_, a_, /*full=*/true);
@@ -1140,6 +1172,16 @@ int FixedStepper::step(RigidState& s) {
     // near-flat coin's, which a shorter step removes (kind B, issue 13: quarter `impulse` 2e4
     // tosses 32 -> 6 clamps); the gravity-phase cap, which it does not, is left to be counted.
     halve_while_capped();
+  }
+  if (m.curved() && c.n > 0) {
+    // The accepted step still capped, or its rim ending below the floor (to be lifted, below):
+    // a coin lying or landing nearly flat whose contact set is one rim point. Its tripod struck
+    // instead where it reaches the floor within the full step or lies within that depth.
+    const double below = -(done->s.position.z() + rim_lowest(m, done->s.R));
+    if ((done->to_halve() || below > touch_tol_) && lands_flat(h_, std::max(0.0, below))) {
+      ++flat_landed;
+      return step(s);
+    }
   }
   const Attempt& a = *done;
   s = a.s;
@@ -1219,6 +1261,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->slaps += st.slaps;
       stats->slap_no_arrival += st.slap_no_arrival;
       stats->slap_rim_below += st.slap_rim_below;
+      stats->flat_landed += st.flat_landed;
       stats->max_held_sink = std::max(stats->max_held_sink, st.max_held_sink);
       stats->held_sinks += st.held_sinks;
       stats->sink_shortened += st.sink_shortened;

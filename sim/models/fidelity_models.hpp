@@ -31,6 +31,7 @@ inline void add_stepper_stats(TossProbe& probe, const StepperStats& stats) {
   probe.slaps += stats.slaps;
   probe.slap_no_arrival += stats.slap_no_arrival;
   probe.slap_rim_below += stats.slap_rim_below;
+  probe.flat_landed += stats.flat_landed;
 }
 
 // `static`: the initial orientation, then the quasi-static roll (sim/rest.hpp). No dynamics.
