@@ -626,14 +626,14 @@ TEST(CylinderImpulse, FaceLandingFlatStrikesItsTripod) {
   expect_quarter_tosses_unlifted({1568u, 2977u, 4170u, 19608u});
 }
 
-// A coin landing or lying nearly flat (tilt 1e-6 to 6e-5 rad) whose contact set is one rim point:
-// its rim's lowest point runs round the near half while the face comes down, so a slap's located
-// step left the rest of the rim below the floor, or the curvature impulse stayed capped after the
-// halvings (a plain step's, not a slap), and the rim was lifted, 0.02-30 um. Now such a step is
-// taken again with the face's tripod struck when it reaches the floor within the step or lies
-// that close (lands_flat, contact_stepper.cpp). Every toss here clamped and lifted before (quarter
-// `impulse`: all six of 2e4, seed 1; quarter-table: its only lift in 2e4); none now, and each
-// took the tripod path.
+// A coin landing or lying nearly flat (tilt 1e-6 to 6e-5 rad) on one rim point: its rim's lowest
+// point runs round the rim while the face comes down, so the curvature impulse stayed capped after
+// the halvings (after a slap's located step had left the rest of the rim below and the plain step
+// ran instead) and the rim was lifted, 0.07-30 um. Now a step that would clamp or lift is taken
+// again with the face's tripod struck when it reaches the floor within the step or lies that
+// close (FixedStepper::step). Every toss here clamped or lifted before (quarter `impulse`: all six
+// clamps and lifts of 2e4, seed 1; quarter-table: its only lift in 2e4); none now, and each took
+// the tripod path.
 TEST(CylinderImpulse, NearlyFlatFaceLandingIsStruckNotLifted) {
   const auto check = [](const char* scene, std::initializer_list<std::uint64_t> tosses) {
     const DieModel m =

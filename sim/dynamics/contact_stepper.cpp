@@ -796,8 +796,8 @@ void FixedStepper::add_face_tripod(const RigidState& s, ContactSet& c, double wi
   // impulse could not hold it without gaining energy (capped, halved four times) and it was
   // lifted. The face's tripod joins the set when its features are within the impulse model's
   // strike tolerance (1e-6 r, corners that close strike together), as a polyhedron's face does.
-  // step() may widen that (lands_flat): each within `depth`, or reaching the floor within
-  // `window` at its approach speed.
+  // step() widens that where the step would clamp or lift (a coin landing nearly flat): each
+  // within `depth`, or reaching the floor within `window` at its approach speed.
   const DieModel& m = *m_;
   const double face_tol = 1e-6 * m.bounding_radius;
   const auto joins = [&](int f) {
@@ -1127,34 +1127,10 @@ int FixedStepper::step(RigidState& s) {
     }
     ++halved;
   };
-  // A coin so nearly flat that its face lands within `window`: its tripod reaches the floor within
-  // it at its approach speed (add_face_tripod). Then the step is taken again from the start with
-  // the tripod in the contact set, struck at once as a polyhedron's landing face is (the gap it
-  // leaves is what the tripod would close within the window), instead of a step whose rim the
-  // curvature impulse could not hold (below). Once per step.
-  const auto lands_flat = [&](double window, double depth) {
-    if (relanded) return false;
-    ContactSet wide = c;
-    add_face_tripod(s, wide, window, depth);
-    if (wide.n == c.n) return false;
-    land_window_ = window;
-    land_depth_ = depth;
-    return true;
-  };
   // A slap's step whose near half the capped curvature impulse leaves sinking: halved as a plain
   // step would be, still a slap's (its end then before the far half's arrival).
   if (slap_rims_ != 0 && done->to_halve()) halve_while_capped();
   if (slap_rims_ != 0 && done->s.position.z() + rim_lowest(m, done->s.R) < -touch_tol_) {
-    // A coin so nearly flat that its rim's lowest point runs round the near half while the far
-    // half comes down: the face is landing. If its tripod reaches the floor within the located
-    // step, the step is taken again with the tripod in the contact set (struck at once, as a
-    // polyhedron's face; it would be within dt anyway), not as the plain step, whose search
-    // cannot see the far half and whose capped curvature impulse left the rim to be lifted.
-    if (lands_flat(dt, 0.0)) {
-      ++slap_rim_below;
-      ++flat_landed;
-      return step(s);
-    }
     ++slap_rim_below;
     slap_rims_ = 0;
     try_step(s0, c, h_, a_, /*full=*/true);
@@ -1173,14 +1149,24 @@ int FixedStepper::step(RigidState& s) {
     // tosses 32 -> 6 clamps); the gravity-phase cap, which it does not, is left to be counted.
     halve_while_capped();
   }
-  if (m.curved() && c.n > 0) {
-    // The accepted step still capped, or its rim ending below the floor (to be lifted, below):
-    // a coin lying or landing nearly flat whose contact set is one rim point. Its tripod struck
-    // instead where it reaches the floor within the full step or lies within that depth.
+  if (m.curved() && c.n > 0 && !relanded) {
+    // The accepted step still capped after the halvings (a clamp), or its rim ending below the
+    // floor (a lift, at the end): seen only for a coin landing or lying nearly flat (tilt 1e-6 to
+    // 6e-5 rad) on one rim point, whose lowest point runs round the rim while the face comes
+    // down. If the face's tripod reaches the floor within the full step at its approach speed, or
+    // lies within the depth the lift would close, the step is taken again from its start with the
+    // tripod in the contact set: struck at once, as a polyhedron's landing face is (what it
+    // closes early is what the step would close anyway, at most the lift it replaces). Once.
     const double below = -(done->s.position.z() + rim_lowest(m, done->s.R));
-    if ((done->to_halve() || below > touch_tol_) && lands_flat(h_, std::max(0.0, below))) {
-      ++flat_landed;
-      return step(s);
+    if (done->to_halve() || below > touch_tol_) {
+      ContactSet wide = c;
+      add_face_tripod(s, wide, h_, std::max(0.0, below));
+      if (wide.n > c.n) {
+        land_window_ = h_;
+        land_depth_ = std::max(0.0, below);
+        ++flat_landed;
+        return step(s);
+      }
     }
   }
   const Attempt& a = *done;

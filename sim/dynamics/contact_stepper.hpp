@@ -97,10 +97,9 @@ class FixedStepper {
   // because a located slap step left the rest of the rim below the floor.
   std::uint64_t slap_no_arrival = 0;
   std::uint64_t slap_rim_below = 0;
-  // Curved dice: steps taken again from their start with the face's tripod struck (lands_flat in
-  // step()): a located slap that left the rest of the rim below the floor (also in slap_rim_below),
-  // or a step still capped after the halvings or ending with its rim below the floor, where the
-  // tripod reaches the floor within that step or lies that close.
+  // Curved dice: steps still capped after the halvings or ending with the rim below the floor,
+  // taken again from their start with the face's tripod struck because it reaches the floor
+  // within the step or lies that close (step(): a coin landing or lying nearly flat).
   std::uint64_t flat_landed = 0;
   double max_held_sink = 0.0;            // flat dice: deepest held corner below the floor at a step's end (m)
   std::uint64_t held_sinks = 0;          // flat dice: steps in which a held corner sank more than max_sink (or touch_tol)
@@ -253,7 +252,7 @@ class FixedStepper {
   // A slap located step whose whole rim still ends below the floor (the lowest point ran round the
   // rim on the near half first) is dropped for the plain step.
   int slap_rims_ = 0;
-  // > 0: the next step() widens add_face_tripod by these (a coin landing or lying flat, lands_flat).
+  // > 0: the next step() widens add_face_tripod by these (a coin landing or lying nearly flat).
   double land_window_ = 0.0, land_depth_ = 0.0;
   Vec3 free_end_row_ = Vec3::Zero();  // the full step's bottom row at its end, after the start's solve only
   double slap_u_[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
@@ -285,7 +284,7 @@ struct StepperStats {
   std::uint64_t slaps = 0;
   std::uint64_t slap_no_arrival = 0;  // a slap's far half did not arrive: the plain step taken
   std::uint64_t slap_rim_below = 0;   // a located slap left the rest of the rim below: the plain search again
-  std::uint64_t flat_landed = 0;      // steps taken again with a nearly flat face's tripod struck (lands_flat)
+  std::uint64_t flat_landed = 0;      // steps taken again with a nearly flat face's tripod struck
   // Flat dice (not corrections: a step's discretisation, reported): the deepest held corner below
   // the floor at a step's end, the steps that ended deeper than the max_sink bound, and with
   // max_sink the steps tried again shorter and those whose full length was below h.
