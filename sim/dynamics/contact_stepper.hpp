@@ -138,7 +138,8 @@ class FixedStepper {
     bool rise_dropped = false;  // flat: they could not be without gaining energy (the plain solve instead)
   };
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
-  // A curved die lying flat to within the strike tolerance: its face's tripod added to c.
+  // A curved die lying flat to within the strike tolerance: its face's tripod added to c (also
+  // when each tripod point lies within `depth` or reaches the floor within `window`: step()).
   void add_face_tripod(const RigidState& s, ContactSet& c, double window = 0.0, double depth = 0.0) const;
   // try_step with the held corners asked to rise at `bias` (m/s, 0: none); false if that gains
   // energy (kinetic + m g (COM height + the deepest corner's depth)).
