@@ -1149,6 +1149,8 @@ int FixedStepper::step(RigidState& s) {
     // tosses 32 -> 6 clamps); the gravity-phase cap, which it does not, is left to be counted.
     halve_while_capped();
   }
+  // A curved die's rims at the accepted step's end, below the floor by this (lifted at the end).
+  const double below = m.curved() ? -(done->s.position.z() + rim_lowest(m, done->s.R)) : 0.0;
   if (m.curved() && c.n > 0 && !relanded) {
     // The accepted step still capped after the halvings (a clamp), or its rim ending below the
     // floor (a lift, at the end): seen only for a coin landing or lying nearly flat (tilt 1e-6 to
@@ -1157,7 +1159,6 @@ int FixedStepper::step(RigidState& s) {
     // lies within the depth the lift would close, the step is taken again from its start with the
     // tripod in the contact set: struck at once, as a polyhedron's landing face is (what it
     // closes early is what the step would close anyway, at most the lift it replaces). Once.
-    const double below = -(done->s.position.z() + rim_lowest(m, done->s.R));
     if (done->to_halve() || below > touch_tol_) {
       ContactSet wide = c;
       add_face_tripod(s, wide, h_, std::max(0.0, below));
@@ -1208,7 +1209,7 @@ int FixedStepper::step(RigidState& s) {
     // left them deeper (a slapping rim, whose plain solve does not push, rim_support; a bias not
     // bracketed; a search out of trials) the COM is lifted by the residual, counted. (The energy
     // check above is of the step itself; the lift's m g dz is that counted correction.)
-    const double pen = -(s.position.z() + rim_lowest(m, s.R));
+    const double pen = below;  // (s is the accepted attempt's state, unchanged since)
     max_penetration = std::max(max_penetration, pen);
     if (pen > touch_tol_) {
       s.position.z() += pen;
