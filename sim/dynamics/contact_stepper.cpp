@@ -875,7 +875,7 @@ int FixedStepper::step(RigidState& s) {
   const DieModel& m = *m_;
   ContactSet c;
   if (s.position.z() <= m.bounding_radius + touch_tol_) c = touching_corners(m, s, touch_tol_);
-  const bool relanded = land_window_ > 0.0 || land_depth_ > 0.0;
+  const bool relanded = land_window_ > 0.0;  // this is the step taken again (below)
   if (m.curved() && c.n > 0) add_face_tripod(s, c, land_window_, land_depth_);
   land_window_ = land_depth_ = 0.0;
   const double E0 = mechanical_energy(m, s);
@@ -1153,12 +1153,13 @@ int FixedStepper::step(RigidState& s) {
   const double below = m.curved() ? -(done->s.position.z() + rim_lowest(m, done->s.R)) : 0.0;
   if (m.curved() && c.n > 0 && !relanded) {
     // The accepted step still capped after the halvings (a clamp), or its rim ending below the
-    // floor (a lift, at the end): seen only for a coin landing or lying nearly flat (tilt 1e-6 to
-    // 6e-5 rad) on one rim point, whose lowest point runs round the rim while the face comes
+    // floor (a lift, at the end): in every case examined a coin landing or lying nearly flat (tilt
+    // 1e-6 to 6e-5 rad) on one rim point, whose lowest point runs round the rim while the face comes
     // down. If the face's tripod reaches the floor within the full step at its approach speed, or
     // lies within the depth the lift would close, the step is taken again from its start with the
     // tripod in the contact set: struck at once, as a polyhedron's landing face is (what it
-    // closes early is what the step would close anyway, at most the lift it replaces). Once.
+    // closes early is what the step would close anyway, at most the lift it replaces). Once. (The
+    // discarded attempt's work counters, located, halved and the slap's, stay counted.)
     if (done->to_halve() || below > touch_tol_) {
       ContactSet wide = c;
       add_face_tripod(s, wide, h_, std::max(0.0, below));

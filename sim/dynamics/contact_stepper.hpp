@@ -253,7 +253,8 @@ class FixedStepper {
   // A slap located step whose whole rim still ends below the floor (the lowest point ran round the
   // rim on the near half first) is dropped for the plain step.
   int slap_rims_ = 0;
-  // > 0: the next step() widens add_face_tripod by these (a coin landing or lying nearly flat).
+  // Set (window = the full step, > 0) when step() takes a step again with the face's tripod struck
+  // (a coin landing or lying nearly flat): its next call widens add_face_tripod by these, once.
   double land_window_ = 0.0, land_depth_ = 0.0;
   Vec3 free_end_row_ = Vec3::Zero();  // the full step's bottom row at its end, after the start's solve only
   double slap_u_[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
