@@ -632,10 +632,12 @@ TEST(CylinderImpulse, FaceLandingFlatStrikesItsTripod) {
 // ran instead) and the rim was lifted, 0.07-30 um. Now a step that would clamp or lift is taken
 // again with the face's tripod struck when it reaches the floor within the step or lies that
 // close (FixedStepper::step). Every toss here clamped or lifted before (quarter `impulse`: all six
-// clamps and lifts of 2e4, seed 1; quarter-table: its only lift in 2e4); none now, and each took
-// the tripod path.
+// clamps and lifts of 2e4, seed 1; quarter-table: its only lift in 2e4); none does now. Two still
+// take the tripod path; the other four no longer reach it, since the curvature impulse's energy
+// check counts a rim's depth below the floor (held energy): their first clamp was the rise of a
+// rim an earlier step had left below.
 TEST(CylinderImpulse, NearlyFlatFaceLandingIsStruckNotLifted) {
-  const auto check = [](const char* scene, std::initializer_list<std::uint64_t> tosses) {
+  const auto check = [](const char* scene, std::initializer_list<std::uint64_t> tosses, bool tripod) {
     const DieModel m =
         compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/" + scene, {"sim.fidelity=\"impulse\""}));
     for (const std::uint64_t i : tosses) {
@@ -644,12 +646,17 @@ TEST(CylinderImpulse, NearlyFlatFaceLandingIsStruckNotLifted) {
       EXPECT_EQ(r.corrections.energy_clamps, 0u) << scene << " " << i;
       EXPECT_EQ(r.corrections.overlap_fixes, 0u) << scene << " " << i;
       EXPECT_EQ(r.corrections.pgs_unconverged, 0u) << scene << " " << i;
-      EXPECT_GE(probe.flat_landed, 1u) << scene << " " << i;
+      if (tripod) {
+        EXPECT_GE(probe.flat_landed, 1u) << scene << " " << i;
+      } else {
+        EXPECT_EQ(probe.flat_landed, 0u) << scene << " " << i;
+      }
       EXPECT_LE(probe.max_energy_gain, 1e-12) << scene << " " << i;
     }
   };
-  check("quarter.toml", {3259u, 6927u, 10377u, 10420u, 19432u});
-  check("quarter-table.toml", {16450u});
+  check("quarter.toml", {3259u}, true);
+  check("quarter-table.toml", {16450u}, true);
+  check("quarter.toml", {6927u, 10377u, 10420u, 19432u}, false);
 }
 
 // A near-flat coin spinning fast: the rim's lowest point runs round the rim, its height far from
