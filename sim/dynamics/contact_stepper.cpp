@@ -362,7 +362,7 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
   // above the floor that comes down converts m g height into motion, which a projection onto the
   // floor would read as a gain.
   const double mg = m.mass * m.gravity;
-  const double e_allow = e_start + mg * std::max(0.0, -phi(0.0));
+  double e_allow = e_start;  // plus the start's depth, evaluated only when the check needs it
   const auto energy_end = [&] {
     return kinetic_energy(m, mid) + mg * (mid.position.z() + mid.velocity.z() * rest + std::max(0.0, -gap_end));
   };
@@ -391,6 +391,7 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
       g = solve(b);
     }
   }
+  if (energy_end() > e_allow) e_allow += mg * std::max(0.0, -phi(0.0));
   if (energy_end() > e_allow) {  // the largest b that gains nothing (or b = 0, the plain solve)
     // Where the gain comes from, measured: the impulse's own kinetic work, or gravity's share
     // g P_z (d - tau) (the COM it lifts in the step's second half, whose kick was at the start).
