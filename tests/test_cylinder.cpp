@@ -871,3 +871,43 @@ TEST(CylinderStepped, EulersDiskPrecessesAtTheSteadyRate) {
 }
 
 }  // namespace
+
+// A quarter landing flat on its face's tripod (quarter-table `impulse` toss 97669, seed 1: 0.4 m/s
+// down, turning at 33 rad/s, the three points coplanar): the restitution phase's friction stalled
+// in Gauss-Seidel (still moving at 20 000 sweeps: the tangential compliance of coplanar points has
+// rank 3 of 6) and the Newton finish failed, counted unconverged. The dual solve (any number of
+// points, on the body's velocity, which is unique) now takes it; it accepts only impulses that
+// verify Coulomb's law with maximal dissipation at every point (friction_impact.cpp).
+TEST(CylinderImpulse, FlatTripodFrictionSolvesWhereGaussSeidelStalls) {
+  const DieModel m = compile(
+      load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter-table.toml", {"sim.fidelity=\"impulse\""}));
+  RigidState s;
+  s.position = Vec3(0.044170438812751324, -0.051990465691381611, 0.00087504609907929705);
+  s.velocity = Vec3(-0.10391559289198717, -0.12524045691629959, -0.39662679738088846);
+  s.omega = Vec3(25.951735011921091, -20.832068526095441, -0.30988413524908581);
+  s.R << -0.97409536039430611, -0.22613763254394517, -2.3894738940127835e-06, 0.22613763255055694,
+      -0.97409536039107714, -3.0005637251754452e-06, -1.6490350575239926e-06, -3.4631851697128587e-06,
+      0.99999999999263978;
+  ContactSet c;
+  c.n = 3;
+  c.vertex[0] = 3;
+  c.vertex[1] = 4;
+  c.vertex[2] = 5;
+  ContactImpulses out;
+  RigidState after = s;
+  const ImpactResult r = apply_friction_impact(m, after, c, /*restitution=*/true, nullptr, &out);
+  EXPECT_EQ(r.corrections.pgs_unconverged, 0u);
+  EXPECT_EQ(r.corrections.energy_clamps, 0u);
+  EXPECT_EQ(r.corrections.fallbacks, 0u);
+  EXPECT_LE(r.energy_after, r.energy_before);
+  ASSERT_EQ(out.n, 3);
+  // The totals over both phases (compression's friction and restitution's) lie in each point's
+  // cone, and every point leaves the floor.
+  const double speed = s.velocity.norm() + m.bounding_radius * s.omega.norm();
+  for (int i = 0; i < out.n; ++i) {
+    const Vec3& P = out.P[i];
+    EXPECT_GT(P.z(), 0.0) << i;
+    EXPECT_LE(std::hypot(P.x(), P.y()), m.max_friction * P.z() * (1.0 + 1e-9)) << i;
+    EXPECT_GE(corner_velocity(m, after, out.vertex[i]).z(), -1e-9 * speed) << i;
+  }
+}
