@@ -116,6 +116,8 @@ nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
           {"slap_rim_below_per_toss", static_cast<double>(probe.slap_rim_below) / np},
           // Steps taken again with a nearly flat face's tripod struck (a coin landing or lying flat).
           {"flat_landed_per_toss", static_cast<double>(probe.flat_landed) / np},
+          // Impacts whose restitution friction stalled in Gauss-Seidel and was solved by its dual.
+          {"dual_solves", probe.dual_solves},
           // A flat die's held corners: the deepest one below the floor at a step's end (m), the
           // steps in which one sank more than the bound, and (`impulse`) the steps tried again
           // shorter for the bound and those whose full length was below the contact step.
@@ -149,6 +151,9 @@ void print_text(const nlohmann::json& r) {
   std::printf("  identical counts    %s\n", r["identical_counts"].get<bool>() ? "yes" : "NO (a bug: please report)");
   std::printf("  impacts per toss    %.3f\n  search steps/flight %.2f\n", r["impacts_per_toss"].get<double>(),
               r["search_steps_per_flight"].get<double>());
+  if (r["dual_solves"].get<std::uint64_t>() > 0)
+    std::printf("  dual friction solves %llu (restitution friction that stalled in Gauss-Seidel; verified)\n",
+                static_cast<unsigned long long>(r["dual_solves"].get<std::uint64_t>()));
   if (r["fixed_steps_per_toss"].get<double>() > 0) {
     std::printf("  fixed steps/toss    %.1f\n", r["fixed_steps_per_toss"].get<double>());
     std::printf("    located %.3f  halved %.3f  capped curvature %.3f  slaps %.3f (no arrival %.4f, rim below %.4f)  landed "
@@ -260,7 +265,7 @@ void register_bench(CLI::App& app, int& exit_code) {
                 "tosses_per_s (all threads), scaling_efficiency, identical_counts, impacts_per_toss,\n"
                 "search_steps_per_flight, fixed_steps_per_toss, located_steps_per_toss,\n"
                 "halved_steps_per_toss, curvature_capped_per_toss, slaps_per_toss, slap_no_arrival_per_toss,\n"
-                "slap_rim_below_per_toss, flat_landed_per_toss, phases {name: {share, per_toss, us_each}},\n"
+                "slap_rim_below_per_toss, flat_landed_per_toss, dual_solves, phases {name: {share, per_toss, us_each}},\n"
                 "other_share; with one fidelity its fields also at the top level");
   cmd->callback([args, &exit_code] { exit_code = run_bench(*args); });
 }

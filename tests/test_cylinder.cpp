@@ -899,6 +899,7 @@ TEST(CylinderImpulse, FlatTripodFrictionSolvesWhereGaussSeidelStalls) {
   EXPECT_EQ(r.corrections.pgs_unconverged, 0u);
   EXPECT_EQ(r.corrections.energy_clamps, 0u);
   EXPECT_EQ(r.corrections.fallbacks, 0u);
+  EXPECT_EQ(r.dual_solves, 1);  // taken by the dual, and counted
   EXPECT_LE(r.energy_after, r.energy_before);
   ASSERT_EQ(out.n, 3);
   // The totals over both phases (compression's friction and restitution's) lie in each point's

@@ -391,8 +391,9 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
       g = solve(b);
     }
   }
-  if (energy_end() > e_allow) e_allow += mg * std::max(0.0, -phi(0.0));
-  if (energy_end() > e_allow) {  // the largest b that gains nothing (or b = 0, the plain solve)
+  const double e_end = energy_end();
+  if (e_end > e_allow) e_allow += mg * std::max(0.0, -phi(0.0));
+  if (e_end > e_allow) {  // the largest b that gains nothing (or b = 0, the plain solve)
     // Where the gain comes from, measured: the impulse's own kinetic work, or gravity's share
     // g P_z (d - tau) (the COM it lifts in the step's second half, whose kick was at the start).
     // Positive work: its target b is above the point's reflection, the lowest point's height far
@@ -1193,6 +1194,7 @@ int FixedStepper::step(RigidState& s) {
     ++impacts;
     corrections.add(a.imp.corrections);
     sweeps += static_cast<std::uint64_t>(a.imp.iterations);
+    dual_solves += static_cast<std::uint64_t>(a.imp.dual_solves);
     max_energy_gain = std::max(max_energy_gain, relative_gain(a.imp.energy_before, a.imp.energy_after));
   }
   // An accepted step whose curvature impulse was capped (to gain no energy) is a clamp, counted
@@ -1266,6 +1268,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->slap_no_arrival += st.slap_no_arrival;
       stats->slap_rim_below += st.slap_rim_below;
       stats->flat_landed += st.flat_landed;
+      stats->dual_solves += st.dual_solves;
       stats->max_held_sink = std::max(stats->max_held_sink, st.max_held_sink);
       stats->held_sinks += st.held_sinks;
       stats->sink_shortened += st.sink_shortened;

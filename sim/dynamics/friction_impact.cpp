@@ -408,6 +408,7 @@ namespace {
 struct SweepResult {
   int sweeps = 0;
   bool converged = true;
+  bool dual = false;  // solve_friction: taken by its dual fallback (counted, ImpactResult::dual_solves)
 };
 
 // Semismooth Newton on the Alart-Curnier equations of the same plastic frictional problem, for
@@ -1031,6 +1032,14 @@ constexpr double kVerifyCone = 1e-9;   // |P_i| <= R_i (1 + this)
 constexpr double kVerifySlip = 1e-9;   // a point slipping less than this fraction of the speeds sticks
 constexpr double kVerifyAlign = 1e-6;  // sliding: |P_i / R_i + u_i / |u_i|| <= this
 
+// Coulomb with maximal dissipation at one point, as the exact solves accept it: |P| <= R (to
+// kVerifyCone) and, where it slips more than slip_tol and carries friction, P opposite the slip.
+bool coulomb_verifies(const Eigen::Vector2d& P, const Eigen::Vector2d& u, double R, double slip_tol) {
+  if (!P.allFinite() || P.norm() > R * (1.0 + kVerifyCone)) return false;
+  const double un = u.norm();
+  return un <= slip_tol || !(R > 0.0) || !((P / R + u / un).norm() > kVerifyAlign);
+}
+
 // x on the circle |x| = radius minimising x.A x / 2 + g.x, A symmetric positive semidefinite 2x2
 // (possibly singular: min_on_disc assumes definite): x = -(A + lambda 1)^-1 g, lambda >= 0 found
 // in its bracket [|g| / radius - l_max, |g| / radius - l_min] by Newton on 1/|x| - 1/radius,
@@ -1086,11 +1095,8 @@ bool solve_friction_edge(const Body& b, const Points& pts, const double radius[]
     const Eigen::Vector2d P[2] = {P1, P2};
     const Eigen::Vector2d u[2] = {g1 + A11 * P1 + A12 * P2, g2 + A21 * P1 + A22 * P2};
     const double R[2] = {R1, R2};
-    for (int i = 0; i < 2; ++i) {
-      if (!P[i].allFinite() || P[i].norm() > R[i] * (1.0 + kVerifyCone)) return false;
-      const double un = u[i].norm();
-      if (!(un <= slip_tol) && (P[i] / R[i] + u[i] / un).norm() > kVerifyAlign) return false;
-    }
+    for (int i = 0; i < 2; ++i)
+      if (!coulomb_verifies(P[i], u[i], R[i], slip_tol)) return false;
     return true;
   };
   const auto accept = [&](const Eigen::Vector2d& P1, const Eigen::Vector2d& P2) {
@@ -1317,10 +1323,13 @@ bool solve_friction_dual(const Body& b, const Points& pts, const double radius[]
     }
     nu = nu_b;
     if (ns > 0) {
-      Eigen::MatrixXd Ts(2 * ns, 6);
+      // Dynamic sizes with fixed maxima: on the stack, no allocation in a toss.
+      constexpr int kMax = 2 * kMaxContacts;
+      Eigen::Matrix<double, Eigen::Dynamic, 6, 0, kMax, 6> Ts(2 * ns, 6);
       for (int k = 0; k < ns; ++k) Ts.middleRows<2>(2 * k) = T[idx[k]];
-      const Eigen::MatrixXd A = Ts * Minv * Ts.transpose();
-      const Eigen::VectorXd Ps = A.completeOrthogonalDecomposition().solve(-(Ts * nu_b));
+      const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMax, kMax> A = Ts * Minv * Ts.transpose();
+      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMax, 1> Ps =
+          A.completeOrthogonalDecomposition().solve(-(Ts * nu_b));
       for (int k = 0; k < ns; ++k) P[idx[k]] = Ps.segment<2>(2 * k);
       nu = nu_b + Minv * Ts.transpose() * Ps;
     }
@@ -1328,14 +1337,8 @@ bool solve_friction_dual(const Body& b, const Points& pts, const double radius[]
   const RigidState start = *b.s;
   for (int i = 0; i < n; ++i) b.apply(pts.r[i], Vec3(P[i].x(), P[i].y(), 0.0));
   for (int i = 0; i < n; ++i) {
-    if (!P[i].allFinite() || P[i].norm() > radius[i] * (1.0 + kVerifyCone)) {
-      *b.s = start;
-      return false;
-    }
-    const Vec3 uf = b.point_velocity(pts.r[i]);
-    const Eigen::Vector2d u(uf.x(), uf.y());
-    const double un = u.norm();
-    if (un > slip_tol && (radius[i] == 0.0 || (P[i] / radius[i] + u / un).norm() > kVerifyAlign)) {
+    const Vec3 u = b.point_velocity(pts.r[i]);
+    if (!coulomb_verifies(P[i], Eigen::Vector2d(u.x(), u.y()), radius[i], slip_tol)) {
       *b.s = start;
       return false;
     }
@@ -1420,7 +1423,7 @@ SweepResult solve_friction(const Body& b, const Points& pts, const double radius
     Eigen::Vector2d dual_pt[kMaxContacts];
     if (solve_friction_dual(b, pts, radius, dual_pt, speed, lever)) {
       for (int i = 0; i < pts.n; ++i) pt[i] = dual_pt[i];
-      return {kMaxSweeps + nr.iterations + 1, true};
+      return {kMaxSweeps + nr.iterations + 1, true, true};
     }
     b.s->velocity = v_gs;  // back to the Gauss-Seidel iterate, counted by the caller
     b.s->omega = w_gs;
@@ -1668,6 +1671,7 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
         Eigen::Vector2d ft[kMaxContacts];
         const SweepResult sr = solve_friction(b, pts, radius, ft, lever, speed);
         res.iterations += sr.sweeps;
+        if (sr.dual) ++res.dual_solves;
         if (!sr.converged) ++res.corrections.pgs_unconverged;
         for (int i = 0; i < c.n; ++i) total[i] += Vec3(ft[i].x(), ft[i].y(), k * pn[i]);
       }

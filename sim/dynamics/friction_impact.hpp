@@ -105,6 +105,7 @@ struct ImpactResult {
   double energy_before = 0.0;   // kinetic energy (J)
   double energy_after = 0.0;
   int iterations = 0;           // Gauss-Seidel sweeps (both phases; 0 for an exact one-point solve)
+  int dual_solves = 0;          // restitution friction taken by the dual solve after Gauss-Seidel stalled (verified, exact)
   Corrections corrections;      // energy clamp, unconverged solve, fallback of this impact
 };
 

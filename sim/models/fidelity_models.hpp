@@ -32,6 +32,7 @@ inline void add_stepper_stats(TossProbe& probe, const StepperStats& stats) {
   probe.slap_no_arrival += stats.slap_no_arrival;
   probe.slap_rim_below += stats.slap_rim_below;
   probe.flat_landed += stats.flat_landed;
+  probe.dual_solves += stats.dual_solves;
 }
 
 // `static`: the initial orientation, then the quasi-static roll (sim/rest.hpp). No dynamics.
