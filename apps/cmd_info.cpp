@@ -59,14 +59,15 @@ void print_info(const std::string& path, const DieModel& m) {
   }
   if (m.curved()) {
     // A cylinder has no corners: its contact features are points of these two core circles.
-    std::printf("rims (core circles, swept by the rounding; restitution, friction, rolling resistance)\n");
+    std::printf("rims (core circles, swept by the rounding; restitution, friction, rolling and pivoting resistance)\n");
     for (int k = 0; k < 2 && 3 * k < static_cast<int>(m.vertex_rolling.size()); ++k) {
       const double sgn = k == 0 ? 1.0 : -1.0;
       const Vec3 c = m.geo_to_body.transpose() * (m.rims.centre + sgn * m.rims.half * m.rims.axis) + mp.com;
       const std::size_t v = static_cast<std::size_t>(3 * k);
-      std::printf("  %-5s centre (%+.6f, %+.6f, %+.6f)  radius %.6g  e = %.4f  mu = %.3f  rolling %.3g m\n",
+      std::printf("  %-5s centre (%+.6f, %+.6f, %+.6f)  radius %.6g  e = %.4f  mu = %.3f  rolling %.3g m  pivoting %.3g m\n",
                   kCylinderOutcomeNames[static_cast<std::size_t>(k)], c.x(), c.y(), c.z(), m.rims.radius,
-                  m.vertex_restitution[v], m.vertex_friction[v], m.vertex_rolling[v]);
+                  m.vertex_restitution[v], m.vertex_friction[v], m.vertex_rolling[v],
+                  m.vertex_pivoting[v]);
     }
   }
   std::printf("\nfidelity           %s", to_string(m.fidelity));

@@ -49,6 +49,7 @@ nlohmann::json cylinder_json(const DieModel& m) {
       rim["friction"] = m.vertex_friction[feature];
     }
     if (feature < m.vertex_rolling.size()) rim["rolling_resistance"] = m.vertex_rolling[feature];
+    if (feature < m.vertex_pivoting.size()) rim["pivoting_resistance"] = m.vertex_pivoting[feature];
     rims.push_back(rim);
   }
   return {{"radius", r.radius + m.rounding},

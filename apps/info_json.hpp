@@ -15,7 +15,8 @@ namespace dicesim {
 //  "faces": [{"label", "normal", "area", "stable", "p_static"}], "corners", "fidelity",
 //  "fidelity_requested", "fidelity_reason", "rest"}; a cylinder adds "cylinder": {"radius", "height",
 //  "rounding", "axis", "labels": {"heads", "tails", "edge"}, "rims": [{"face", "centre", "normal",
-//  "radius" (the core rim's), "restitution", "friction", "rolling_resistance"}]} and per face
+//  "radius" (the core rim's), "restitution", "friction", "rolling_resistance",
+//  "pivoting_resistance"}]} and per face
 //  "direction" (heads, tails, edge) and "curved". p_static: the probability of reading the face in
 //  `static` with a uniform orientation (its Gauss-map basin; a Fibonacci lattice of
 //  kInfoStaticDirections down directions, error ~1e-5).

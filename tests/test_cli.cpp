@@ -98,6 +98,7 @@ TEST(Cli, InfoJsonDescribesACylinder) {
     EXPECT_NEAR(rim["restitution"].get<double>(), 0.5, 1e-12);
     EXPECT_NEAR(rim["friction"].get<double>(), 0.3, 1e-12);
     EXPECT_NEAR(rim["rolling_resistance"].get<double>(), 3e-4, 1e-15);
+    EXPECT_NEAR(rim["pivoting_resistance"].get<double>(), 3e-6, 1e-18);
   }
   ASSERT_EQ(j["faces"].size(), 3u);
   const char* names[] = {"heads", "tails", "edge"};

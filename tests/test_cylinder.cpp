@@ -18,6 +18,7 @@
 #include "sim/models/fidelity_models.hpp"
 #include "sim/models/toss.hpp"
 #include "sim/models/toss_random.hpp"
+#include "sim/dynamics/contact.hpp"
 #include "sim/dynamics/contact_stepper.hpp"
 #include "sim/dynamics/friction_impact.hpp"
 #include "sim/scene/scene_error.hpp"
@@ -358,6 +359,52 @@ TEST(CylinderImpulse, RollingResistanceOpposesOnlyTheRoll) {
   EXPECT_NEAR(s.omega.x(), 0.0, 1e-18);
 }
 
+// Pivoting resistance opposes only the spin about the floor's normal, and only on one point: a disc
+// upright on its edge (axis along x) that rolls and tips keeps that motion; its spin about z is
+// slowed by pivoting_resistance * N / (its moment of inertia about z), never reversed, and the
+// kinetic energy falls in a general orientation too. On two points (lying on its side) the sliding
+// friction resists pivoting already: untouched.
+TEST(CylinderImpulse, PivotingResistanceOpposesOnlyTheSpinOnOnePoint) {
+  const DieModel m = coin_model(0.015, 0.0008);
+  ASSERT_EQ(m.vertex_pivoting.size(), static_cast<std::size_t>(kRimFeatures));
+  EXPECT_EQ(m.vertex_pivoting[0], 3e-6);  // the documented default (scenes/README.md)
+  RigidState s;
+  s.R = Eigen::Quaterniond::FromTwoVectors(m.rims.axis, Vec3::UnitX()).toRotationMatrix();  // upright
+  s.position = Vec3(0.0, 0.0, -rim_lowest(m, s.R));
+  ContactSet c;
+  c.n = 1;
+  c.vertex[0] = 0;
+  const double N = 1e-3;
+  s.omega = Vec3(5.0, 0.7, 0.0);  // rolling and tipping
+  apply_pivoting_resistance(m, s, c, N);
+  EXPECT_EQ(s.omega, Vec3(5.0, 0.7, 0.0));
+  s.omega = Vec3(0.0, 0.0, 13.0);  // spinning upright about the vertical diameter
+  apply_pivoting_resistance(m, s, c, N);
+  const Vec3 ez_body = s.R.row(2).transpose();
+  const double I_z = ez_body.dot(m.principal_moments.cwiseProduct(ez_body));
+  EXPECT_NEAR(s.omega.z(), 13.0 - 3e-6 * N / I_z, 1e-12);
+  EXPECT_NEAR(s.omega.x(), 0.0, 1e-12);
+  EXPECT_LT(s.omega.z(), 13.0);
+  s.omega = Vec3(0.0, 0.0, -1e-9);  // a spin it can stop: stopped, not reversed
+  apply_pivoting_resistance(m, s, c, N);
+  EXPECT_NEAR(s.omega.z(), 0.0, 1e-18);
+  c.n = 2;  // both rims' lowest points: lying on its side
+  c.vertex[1] = 3;
+  s.omega = Vec3(0.3, 0.0, 4.0);
+  apply_pivoting_resistance(m, s, c, N);
+  EXPECT_EQ(s.omega, Vec3(0.3, 0.0, 4.0));
+  c.n = 1;  // tilted, spinning about a skew axis: the energy falls, the spin about z shrinks
+  s.R = Eigen::Quaterniond::FromTwoVectors(m.rims.axis, Vec3(0.6, 0.2, 0.77).normalized()).toRotationMatrix();
+  for (const Vec3& w : {Vec3(3.0, -2.0, 7.0), Vec3(-1.0, 4.0, -0.5), Vec3(0.0, 0.0, 1e-7)}) {
+    s.omega = w;
+    const double K0 = kinetic_energy(m, s);
+    apply_pivoting_resistance(m, s, c, 1e-2);
+    EXPECT_LT(kinetic_energy(m, s), K0) << w.transpose();
+    EXPECT_LT(std::abs(s.omega.z()), std::abs(w.z())) << w.transpose();
+    EXPECT_GE(s.omega.z() * w.z(), -1e-30) << w.transpose();  // not reversed (to rounding)
+  }
+}
+
 // The quarter tossed onto a table (scenes/coins/quarter-table.toml): a rim's lowest point is not a
 // material point, and the stepper used to let it sink below the floor (by up to 0.1 mm a step,
 // accumulating to millimetres in 2/3 of the tosses, until both rims were under the floor and the
@@ -632,10 +679,11 @@ TEST(CylinderImpulse, FaceLandingFlatStrikesItsTripod) {
 // ran instead) and the rim was lifted, 0.07-30 um. Now a step that would clamp or lift is taken
 // again with the face's tripod struck when it reaches the floor within the step or lies that
 // close (FixedStepper::step). Every toss here clamped or lifted before (quarter `impulse`: all six
-// clamps and lifts of 2e4, seed 1; quarter-table: its only lift in 2e4); none does now. Two still
-// take the tripod path; the other four no longer reach it, since the curvature impulse's energy
+// clamps and lifts of 2e4, seed 1; quarter-table: its only lift in 2e4); none does now. Three
+// take the tripod path; the other three no longer reach it, since the curvature impulse's energy
 // check counts a rim's depth below the floor (held energy): their first clamp was the rise of a
-// rim an earlier step had left below.
+// rim an earlier step had left below. (10377 reached it again once the rim's pivoting resistance
+// slowed its spin: its path changed, the outcome of the check did not.)
 TEST(CylinderImpulse, NearlyFlatFaceLandingIsStruckNotLifted) {
   const auto check = [](const char* scene, std::initializer_list<std::uint64_t> tosses, bool tripod) {
     const DieModel m =
@@ -654,9 +702,9 @@ TEST(CylinderImpulse, NearlyFlatFaceLandingIsStruckNotLifted) {
       EXPECT_LE(probe.max_energy_gain, 1e-12) << scene << " " << i;
     }
   };
-  check("quarter.toml", {3259u}, true);
+  check("quarter.toml", {3259u, 10377u}, true);
   check("quarter-table.toml", {16450u}, true);
-  check("quarter.toml", {6927u, 10377u, 10420u, 19432u}, false);
+  check("quarter.toml", {6927u, 10420u, 19432u}, false);
 }
 
 // A near-flat coin spinning fast: the rim's lowest point runs round the rim, its height far from
@@ -677,7 +725,11 @@ TEST(CylinderImpulse, NearFlatCurvatureImpulseIsHalvedNotClamped) {
 // spin slows the rocking grows until it leaves the band (+-3.2 deg of upright, where the COM is
 // above the side) and falls flat, like a real spun coin. Steps of 0.1 ms show it from these states
 // (tilt 1.3 deg, 25 and 40 rad/s); 1 ms steps damped the growth and left the coin standing (edge).
-// The scene's contact step (5e-4) must agree with the fine one.
+// The scene's contact step (5e-4) must agree with the fine one. No step may gain held energy: with
+// nothing to slow the spin (a point contact has no torsional friction) the stepper's first-order
+// error raised it at the rock's turning points, 94 and 101 energy clamps in these two states (kind
+// A of issue 13); the rim's pivoting resistance (rim_rest.hpp, the default 3e-6 m) dissipates more
+// than that error, and the coin falls sooner (7.5 -> 5.2 s and 11.2 -> 8.2 s).
 TEST(CylinderImpulse, UprightSpinningQuarterFallsAsItSlows) {
   const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter-table.toml"));
   for (const double w : {25.0, 40.0}) {
@@ -688,10 +740,15 @@ TEST(CylinderImpulse, UprightSpinningQuarterFallsAsItSlows) {
     s.omega = Vec3(0.0, 0.0, w);
     double t = 0.0;
     int impacts = 0;
-    const StepperOutcome o = run_fixed_steps(m, s, t, impacts, m.contact_step, 0.3, /*allow_liftoff=*/true);
+    StepperStats st;
+    const StepperOutcome o =
+        run_fixed_steps(m, s, t, impacts, m.contact_step, 0.3, /*allow_liftoff=*/true, ImpactThreshold::Gravity, &st);
     ASSERT_EQ(o.exit, StepperExit::Settled) << w;
     EXPECT_NE(o.face_down, 2) << w << " rad/s: still standing on edge after " << t << " s";
-    EXPECT_LT(t, 13.0) << w;  // 6-11 s at 0.1-0.5 ms steps
+    EXPECT_LT(t, 13.0) << w;  // 5-8 s at 0.5 ms steps
+    EXPECT_EQ(st.corrections.energy_clamps, 0u) << w;
+    EXPECT_EQ(st.corrections.overlap_fixes, 0u) << w;
+    EXPECT_LE(st.max_energy_gain, 1e-12) << w;
   }
 }
 
@@ -805,7 +862,8 @@ namespace {
 // precession rate Omega:
 //   Omega^2 sin(alpha) (I1 cos(alpha) - I3 (h / 2a) sin(alpha)) = m g (a cos(alpha) - (h/2) sin(alpha)),
 // for a thin disc Omega^2 sin(alpha) = 4 g / a (Moffatt, Nature 404, 833, 2000). The stepper, started
-// on that motion, must keep it: the tilt stays, the normal turns at Omega.
+// on that motion, must keep it: the tilt stays, the normal turns at Omega. (Without rolling or
+// pivoting resistance: the steady motion has a spin about the vertical, which pivoting would slow.)
 struct SteadyRoll {
   double omega_p = 0.0;     // precession rate
   double tilt_drift = 0.0;  // largest |alpha(t) - alpha| (rad)
@@ -816,6 +874,7 @@ SteadyRoll euler_disk(double a, double h, double alpha, double step, double T) {
   char toml[512];
   std::snprintf(toml, sizeof toml,
                 "[materials.steel]\ndensity = 8000\nrestitution = 0\nfriction = 1\nrolling_resistance = 0\n"
+                "pivoting_resistance = 0\n"
                 "[die]\nshape = \"cylinder\"\nradius = %.17g\nheight = %.17g\nmaterial = \"steel\"\n"
                 "[floor]\nrestitution = 0\n[sim]\nfidelity = \"stepped\"\n",
                 a, h);

@@ -378,7 +378,7 @@ material = "steel"
 )", "scenes/x.toml"); });
   EXPECT_EQ(std::string(e.what()),
             "scenes/x.toml: materials.steel.densty = 7848.0: unknown key 'densty' in [materials.steel]; "
-            "allowed: density, restitution, friction, rolling_resistance");
+            "allowed: density, restitution, friction, rolling_resistance, pivoting_resistance");
 
   const SceneError spin = parse_error(kMinimal + "[throw.spin]\nsdd = 3\n");
   EXPECT_EQ(spin.key(), "throw.spin.sdd");
@@ -453,6 +453,18 @@ TEST(SceneErrors, RestitutionOutOfRange) {
   const SceneError floor = parse_error(kMinimal + "[floor]\nrestitution = 1.5\n");
   EXPECT_EQ(floor.key(), "floor.restitution");
   EXPECT_EQ(floor.value(), "1.5");
+}
+
+TEST(SceneErrors, ContactResistancesOutOfRange) {
+  for (const char* key : {"rolling_resistance", "pivoting_resistance"}) {
+    for (const char* bad : {"-0.001", "0.2"}) {
+      const SceneError e = parse_error(kMinimal, {std::string("materials.wood.") + key + "=" + bad});
+      EXPECT_EQ(e.key(), std::string("materials.wood.") + key);
+      EXPECT_EQ(e.value(), bad);
+      EXPECT_EQ(e.allowed(), "must be a number in [0, 0.1] m");
+    }
+  }
+  EXPECT_EQ(parse_scene(kMinimal, "mem.toml").materials.at("wood").pivoting_resistance, 3e-6);  // the default
 }
 
 TEST(SceneErrors, NanAndInfinity) {

@@ -175,7 +175,7 @@ Body build_cylinder(const SceneDef& scene, const std::string& origin) {
     const std::vector<HalfSpace> slab = {{Vec3(0, 0, -sgn), -(0.5 * die.height - skin)}};
     const double whole = solid(slab).volume;
     const MaterialDef& base = scene.materials.at(die.base_material);
-    double fb = 1.0, e = 0.0, mu = 0.0, rr = 0.0;
+    double fb = 1.0, e = 0.0, mu = 0.0, rr = 0.0, rp = 0.0;
     for (const RegionDef& r : die.regions) {
       std::vector<HalfSpace> cuts = slab;
       cuts.insert(cuts.end(), r.half_spaces.begin(), r.half_spaces.end());
@@ -186,12 +186,14 @@ Body build_cylinder(const SceneDef& scene, const std::string& origin) {
       e += f * mat.restitution;
       mu += f * mat.friction;
       rr += f * mat.rolling_resistance;
+      rp += f * mat.pivoting_resistance;
     }
     fb = std::max(0.0, fb);
     for (int j = 0; j < 3; ++j) {
       b.vertex_restitution.push_back(e + fb * base.restitution);
       b.vertex_friction.push_back(mu + fb * base.friction);
       b.vertex_rolling.push_back(rr + fb * base.rolling_resistance);
+      b.vertex_pivoting.push_back(rp + fb * base.pivoting_resistance);
     }
   }
   return b;

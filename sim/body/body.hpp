@@ -31,6 +31,7 @@ struct Body {
   // materials in its face's outer skin.
   CylinderShape cylinder;
   std::vector<double> vertex_rolling;       // per vertex (or rim feature): rolling resistance (m)
+  std::vector<double> vertex_pivoting;      // per vertex (or rim feature): pivoting resistance (m)
 };
 
 // Builds and checks the body a scene describes. Throws SceneError (key, value, allowed range) for

@@ -42,6 +42,7 @@ struct DieModel {
   double bounding_radius = 0.0;            // max |vertex| + rounding from the COM
   Rims rims;                               // a cylinder: vertices is empty, features are rim points
   std::vector<double> vertex_rolling;      // a cylinder: per rim feature, rolling resistance (m)
+  std::vector<double> vertex_pivoting;     // a cylinder: per rim feature, pivoting resistance (m)
   // Corner adjacency along the core's edges (CSR): neighbours of v are
   // vertex_adj[vertex_adj_begin[v] .. vertex_adj_begin[v + 1]).
   std::vector<int> vertex_adj_begin, vertex_adj;

@@ -345,6 +345,7 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
     mid.velocity.z() += b;
     sweeps += res.iterations;
     apply_rolling_resistance(m, mid, cm, res.normal_impulse);
+    apply_pivoting_resistance(m, mid, cm, res.normal_impulse);
     r1 = TorqueFreeRotation(m.principal_moments, mid.R, world_inertia(m, mid.R) * mid.omega);
     const Vec3 z_row = r1.bottom_row(rest);
     double gap = std::numeric_limits<double>::infinity();
@@ -462,6 +463,7 @@ void FixedStepper::start_support(RigidState& s, const ContactSet& c, double d, d
     s.velocity.z() += b;
     sweeps += a.sup.iterations;
     apply_rolling_resistance(m, s, c, a.sup.normal_impulse);
+    apply_pivoting_resistance(m, s, c, a.sup.normal_impulse);
     rot.emplace(m.principal_moments, s.R, world_inertia(m, s.R) * s.omega);
     const Vec3 z_row = rot->bottom_row(d);
     double gap = std::numeric_limits<double>::infinity();

@@ -147,10 +147,10 @@ class FixedStepper {
   // energy (kinetic + m g (COM height + the deepest corner's depth)).
   bool try_step_with(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full, double bias);
   // A curved die's support solve for a step of length d (gravity's kick already in s): the plastic
-  // solve, rolling resistance, and the touching rims' lowest points held on the floor at the
-  // step's end by the curvature impulse at the step's middle (contact_stepper.cpp). Leaves s and
-  // rot such that rot's free motion of s for d is the step's motion. full: the step of length h
-  // (it decides rims_new_).
+  // solve, rolling and pivoting resistance, and the touching rims' lowest points held on the floor
+  // at the step's end by the curvature impulse at the step's middle (contact_stepper.cpp). Leaves
+  // s and rot such that rot's free motion of s for d is the step's motion. full: the step of
+  // length h (it decides rims_new_).
   void rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
                    std::optional<TorqueFreeRotation>& rot, bool full);
   // Its parts: the solve at the step's start (plastic, biased to hold the rims on the floor), and

@@ -155,4 +155,14 @@ void apply_rolling_resistance(const DieModel& m, RigidState& s, const ContactSet
   s.omega -= (w > 0.0 ? lam : -lam) * inv_u;
 }
 
+void apply_pivoting_resistance(const DieModel& m, RigidState& s, const ContactSet& c, double normal_impulse) {
+  if (c.n != 1 || !(normal_impulse > 0.0)) return;
+  const double w = s.omega.z();
+  const double delta = m.vertex_pivoting[static_cast<std::size_t>(c.vertex[0])];
+  if (w == 0.0 || delta <= 0.0) return;
+  const Vec3 inv_z = s.R * s.R.row(2).transpose().cwiseQuotient(m.principal_moments);  // I_w^-1 e_z
+  const double lam = std::min(delta * normal_impulse, std::abs(w) / inv_z.z());
+  s.omega -= (w > 0.0 ? lam : -lam) * inv_z;
+}
+
 }  // namespace dicesim

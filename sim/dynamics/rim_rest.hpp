@@ -40,4 +40,15 @@ double rim_lowest_excluding(const DieModel& m, const Mat3& R, const ContactSet& 
 // rate too (as this once did) held slowly rolling thin discs upright until they stopped.
 void apply_rolling_resistance(const DieModel& m, RigidState& s, const ContactSet& c, double normal_impulse);
 
+// Pivoting resistance for one step in which the die stands on one rim point (c.n == 1) that
+// carried normal impulse `normal_impulse`: an angular impulse pivoting_resistance * normal_impulse
+// about the floor's normal against the spin about it, capped so that it stops that spin at most
+// (energy only falls: Delta K = lam (lam c / 2 - |w_z|) < 0, c = e_z . I_w^-1 e_z). A point
+// contact has no torsional friction of its own; a real contact patch has, and without it a coin
+// spinning upright on its rim never slowed (one toss spun 17 s, and the stepper's first-order
+// error in that motion raised its held energy, counted as energy clamps: docs/fidelity.md).
+// Two or more points (a cylinder on its side, a face's tripod) resist pivoting by their sliding
+// friction already.
+void apply_pivoting_resistance(const DieModel& m, RigidState& s, const ContactSet& c, double normal_impulse);
+
 }  // namespace dicesim

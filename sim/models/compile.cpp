@@ -158,7 +158,8 @@ DieModel start_model(const Body& body, const SceneDef& scene) {
 // A cylinder: principal frame, rim circles, three "faces" (heads, tails, side), rest geometry.
 DieModel compile_cylinder(const Body& body, const SceneDef& scene, const std::string& origin) {
   if (body.face_labels.size() != 3 || body.vertex_restitution.size() != kRimFeatures ||
-      body.vertex_friction.size() != kRimFeatures || body.vertex_rolling.size() != kRimFeatures)
+      body.vertex_friction.size() != kRimFeatures || body.vertex_rolling.size() != kRimFeatures ||
+      body.vertex_pivoting.size() != kRimFeatures)
     throw SceneError(origin, "die.shape", body.kind, "the body is incomplete (labels or materials missing)");
   DieModel m = start_model(body, scene);
   const MassProperties& mp = m.mass_geometric;
@@ -176,6 +177,7 @@ DieModel compile_cylinder(const Body& body, const SceneDef& scene, const std::st
     m.vertex_restitution.push_back(scene.floor.restitution ? *scene.floor.restitution : body.vertex_restitution[f]);
     m.vertex_friction.push_back(body.vertex_friction[f]);
     m.vertex_rolling.push_back(body.vertex_rolling[f]);
+    m.vertex_pivoting.push_back(body.vertex_pivoting[f]);
   }
   // The farthest body point from the COM: on a rim circle (plus the rounding).
   const Vec3 o_perp = rim.centre - rim.centre.dot(rim.axis) * rim.axis;

@@ -157,6 +157,7 @@ constexpr Names<SpinKind, 5> kSpinKinds{{
 }};
 constexpr Names<EndKind, 2> kEndKinds{{{"floor", EndKind::Floor}, {"catch", EndKind::Catch}}};
 constexpr Range kRollingResistance{.lo = 0, .hi = 0.1, .unit = "m"};
+constexpr Range kPivotingResistance{.lo = 0, .hi = 0.1, .unit = "m"};
 constexpr Range kCatchTime{.lo = 0, .hi = 1e3, .lo_open = true, .unit = "s"};
 constexpr Range kCatchTimeSd{.lo = 0, .hi = 1e3, .unit = "s"};
 constexpr Range kTiltSd{.lo = 0, .hi = 180, .unit = "deg"};
@@ -314,6 +315,7 @@ void read_materials(Reader all, std::map<std::string, MaterialDef>& out) {
     def.restitution = m.number("restitution", kRestitution, def.restitution);
     def.friction = m.number("friction", kFriction, def.friction);
     def.rolling_resistance = m.number("rolling_resistance", kRollingResistance, def.rolling_resistance);
+    def.pivoting_resistance = m.number("pivoting_resistance", kPivotingResistance, def.pivoting_resistance);
     m.finish();
     out[std::string(name.str())] = def;
   }
