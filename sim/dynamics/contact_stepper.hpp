@@ -101,6 +101,9 @@ class FixedStepper {
   // taken again from their start with the face's tripod struck because it reaches the floor
   // within the step or lies that close (step(): a coin landing or lying nearly flat).
   std::uint64_t flat_landed = 0;
+  // Curved dice: curvature impulses that held a start's depth below the floor (within the touch
+  // tolerance) because closing it within the step would gain energy (curvature_support).
+  std::uint64_t depth_held = 0;
   // Impacts whose restitution friction was taken by the dual solve (Gauss-Seidel stalled).
   std::uint64_t dual_solves = 0;
   double max_held_sink = 0.0;            // flat dice: deepest held corner below the floor at a step's end (m)
@@ -289,6 +292,7 @@ struct StepperStats {
   std::uint64_t slap_no_arrival = 0;  // a slap's far half did not arrive: the plain step taken
   std::uint64_t slap_rim_below = 0;   // a located slap left the rest of the rim below: the plain search again
   std::uint64_t flat_landed = 0;      // steps taken again with a nearly flat face's tripod struck
+  std::uint64_t depth_held = 0;       // curvature impulses that held a start's depth (closing it gained)
   std::uint64_t dual_solves = 0;      // impacts whose restitution friction the dual solve took
   // Flat dice (not corrections: a step's discretisation, reported): the deepest held corner below
   // the floor at a step's end, the steps that ended deeper than the max_sink bound, and with
