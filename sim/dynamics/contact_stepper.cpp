@@ -367,14 +367,14 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
   const auto energy_end = [&] {
     return kinetic_energy(m, mid) + mg * (mid.position.z() + mid.velocity.z() * rest + std::max(0.0, -gap_end));
   };
-  double g = 0.0, b = 0.0;
-  // The impulse's target b for the end gap `target` (<= 0): sets b and g (the end gap) and leaves
-  // mid, res and gap_end at that solve. Accepted at the target or above it, within the touch
+  double b = 0.0;
+  // The impulse's target b for the end gap `target` (<= 0): sets b and leaves mid, res and gap_end
+  // at that solve. Accepted at the target or above it, within the touch
   // tolerance (one-sided: the next step then starts no deeper than the target, where the
   // impulse's work is <= 0).
   const auto search = [&](double target) {
     b = 0.0;
-    g = solve(0.0);
+    const double g = solve(0.0);
     if (!(g < target && rest > 0.0)) return;
     double lo = 0.0, g_lo = g - target, hi = (target - g) / rest, g_hi = solve(hi) - target;
     for (int k = 0; k < 8 && g_hi < -touch_tol_; ++k) {
@@ -395,12 +395,12 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
       b = br.hi;
       x = solve(b) - target;
     }
-    g = x + target;
   };
   search(0.0);  // the floor
-  bool gains = energy_end() > e_allow;
+  const double e_end = energy_end();
+  bool gains = e_end > e_allow;
   const double phi0 = gains ? phi(0.0) : 0.0;
-  if (gains) gains = energy_end() > (e_allow += mg * std::max(0.0, -phi0));
+  if (gains) gains = e_end > (e_allow += mg * std::max(0.0, -phi0));
   if (gains && phi0 < 0.0) {
     // A start below the floor (within the touch tolerance a located step or the start support
     // leaves): closing that depth within the step is work P |phi(0)| / d, which the held energy's
@@ -423,10 +423,10 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
     // (Capped in `impulse` tosses, seed 1: the work is -0.3 to -0.5 % of gravity's share in all
     // 1480 of quarter-table's 1000, steps whose impulses exceed m g d, the rolling coin's kind A;
     // positive, 1.3 to 10^5 times that share, in all 25 of the quarter's and the three-sided
-    // coin's 5000 each. docs/fidelity.md, "Which gain: halved or clamped".) With the held energy,
-    // 290 of the 334 caps in 500 quarter-table tosses end at b = 0: the plain solve's held energy
-    // itself rises, 2e-14 to 7e-13 J a 0.5 ms step, while its rim sinks 3e-11 to 8e-10 m (a coin
-    // spinning upright on its edge): the step's, not the curvature impulse's (docs/fidelity.md).
+    // coin's 5000 each. docs/fidelity.md, "Which gain: halved or clamped".) Kind A was last the
+    // plain solve's own held-energy rise in a coin spinning upright on one rim point, which
+    // nothing dissipated; the rim's pivoting resistance (rim_rest.hpp) removed it (quarter-table
+    // `impulse`, 10^5 tosses: 112 450 clamps -> 1). What caps now is kind B (docs/fidelity.md).
     a.unreflected = kinetic_energy(m, mid) > kinetic_energy(m, base);
     double ok = 0.0, bad = b;
     for (int k = 0; k < 20; ++k) {
@@ -435,7 +435,7 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
       (energy_end() > e_allow ? bad : ok) = x;
     }
     b = ok;
-    g = solve(b);
+    const double g = solve(b);
     ++curvature_capped;
     a.clamped = true;
     a.capped = g < -touch_tol_;
