@@ -44,6 +44,9 @@ health() { grep -oE "$1 [0-9]+" "$2" | tail -n1 | grep -oE '[0-9]+$' || echo 0; 
 nworkers=0
 declare -a wpid
 worker() { nworkers=$((nworkers + 1)); "$bin" worker --once "$@" 2> "$work/worker$nworkers.err" & wpid[$nworkers]=$!; pids+=($!); }
+# Waits (up to 20 s) until workers 1..k have subscribed, so that a short run cannot end before one
+# of them hears it: "did worker k toss?" is then a question about leasing, not process start-up.
+listening() { for ((t = 0; t < 200; t++)); do [ "$(cat "$work"/worker*.err 2>/dev/null | grep -c "listening on")" -ge "$1" ] && return 0; sleep 0.1; done; fail "workers not listening after 20 s"; }
 aggregate() { "$bin" aggregate "$scene" --tosses "$n" --seed "$seed" --json --timeout 150 "$@" > "$work/out.json" 2> "$work/agg.err"; }
 
 case "$scenario" in
@@ -51,6 +54,7 @@ case "$scenario" in
     n=150000
     reference 1
     worker; worker; worker
+    listening 3
     aggregate || fail "aggregate exited $?"
     same_as_reference "$work/out.json"
     for i in 1 2 3; do grep -qE "ended: finished \([1-9][0-9]* tosses" "$work/worker$i.err" || fail "worker $i did no tosses"; done
