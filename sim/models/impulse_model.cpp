@@ -63,7 +63,7 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
       t += c.t;
       break;
     }
-    RigidState at = flight.state(c.t);
+    RigidState at = c.at;  // = flight.state(c.t): the search evaluated the rotation there already
     at.R = Quat(at.R).normalized().toRotationMatrix();
     const ContactSet set = touching_corners(m, at, set_tol);
     // A slow re-landing within one contact step is sustained contact: the stepper takes over from
