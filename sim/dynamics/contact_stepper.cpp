@@ -236,7 +236,8 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   s.omega = w;
   if (!(bias > 0.0)) return true;
   // (New corners below the floor are the located step's business.)
-  return held_energy(s, c) <= e_start_ + m.mass * m.gravity * start_depth_max_;
+  a.held_e = held_energy(s, c);
+  return a.held_e <= e_start_ + m.mass * m.gravity * start_depth_max_;
 }
 
 namespace {
@@ -935,7 +936,8 @@ int FixedStepper::step(RigidState& s) {
     impact_ = un < -(v_impact_ + v_spin_ * s0.omega.squaredNorm());
     if (impact_) imp_ = apply_friction_impact(m, s0, c, /*restitution=*/true, nullptr, nullptr, &geo_);
   }
-  e_start_ = mechanical_energy(m, s0);  // after the impact: every trial's energy check starts here
+  // After the impact: every trial's energy check starts here (without one, s0 is s: E0).
+  e_start_ = impact_ ? mechanical_energy(m, s0) : E0;
   rims_new_ = false;
   slap_rims_ = 0;
   miss_rate_ = 0.0;
@@ -1028,7 +1030,9 @@ int FixedStepper::step(RigidState& s) {
     bool modelled = mg_lo > 0.0, have_mg_d = false;
     double d = 0.5 * h_;
     if (modelled) {
-      mg_hi = model_G(c, h_);
+      // A flat die's model at h_ is the full step itself: its G (lowest_flat of the same p, v, h_
+      // and row: try_step_with's R_end row is bit for bit bottom_row(h_)), plus g (h_ - h_) h_ = 0.
+      mg_hi = m.curved() ? model_G(c, h_) : a_.G;
       mg_d = mg_hi;
       // The first trial's length from the model corrected by the support solve's predicted
       // effect (predicted_miss), the search started from a cubic interpolant of the arriving
@@ -1239,7 +1243,7 @@ int FixedStepper::step(RigidState& s) {
     // A step whose held corners rose: no gain in the rest rules' energy, which adds the deepest
     // corner's depth to the COM height (try_step's check).
     max_energy_gain =
-        std::max(max_energy_gain, relative_gain(E0 + m.mass * m.gravity * start_depth_max_, held_energy(s, c)));
+        std::max(max_energy_gain, relative_gain(E0 + m.mass * m.gravity * start_depth_max_, a.held_e));
   } else {
     max_energy_gain = std::max(max_energy_gain, relative_gain(E0, mechanical_energy(m, s)));
   }

@@ -141,6 +141,7 @@ class FixedStepper {
     bool to_halve() const { return capped || unreflected; }  // step() halves it (halve_while_capped)
     bool risen = false;   // flat: the held corners were asked to rise (try_step); else the plain solve
     bool rise_dropped = false;  // flat: they could not be without gaining energy (the plain solve instead)
+    double held_e = 0.0;  // risen: held_energy of s (its check in try_step_with)
   };
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
   // A curved die lying flat to within the strike tolerance: its face's tripod added to c (also
