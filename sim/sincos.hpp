@@ -158,12 +158,18 @@ alignas(16) inline constexpr double kSincos2Constants[48] = {
   const __m128d w = _mm_sub_pd(c(7), hz);
   const __m128d s = add(r, add(mul(mul(r, z), ps), mul(rr, w)));
   const __m128d co = add(w, add(_mm_sub_pd(_mm_sub_pd(c(7), w), hz), _mm_sub_pd(mul(mul(z, z), pc), mul(r, rr))));
-  alignas(16) double ks[2], ss[2], cs[2];
-  _mm_store_pd(ks, k);
-  _mm_store_pd(ss, s);
-  _mm_store_pd(cs, co);
-  sx = rotate_quadrant({ss[0], cs[0]}, static_cast<std::int64_t>(ks[0]));
-  sy = rotate_quadrant({ss[1], cs[1]}, static_cast<std::int64_t>(ks[1]));
+  // rotate_quadrant for both lanes, in the vector registers: the same bits. |k| < 2^20, so its 32-bit
+  // truncation has the low bits of the 64-bit one, and each 64-bit lane gets its k in both halves.
+  const __m128i ki = _mm_cvttpd_epi32(k);
+  const __m128i kk = _mm_unpacklo_epi32(ki, ki);
+  const __m128i high = _mm_set_epi32(INT32_MIN, 0, INT32_MIN, 0);                   // bit 63 of each lane
+  const __m128d swap = _mm_castsi128_pd(_mm_srai_epi32(_mm_slli_epi32(kk, 31), 31));  // odd quadrant: all ones
+  const __m128d sign_s = _mm_castsi128_pd(_mm_and_si128(_mm_slli_epi32(kk, 30), high));  // bit 1 of k
+  const __m128d sign_c = _mm_castsi128_pd(_mm_and_si128(_mm_slli_epi32(_mm_add_epi32(kk, _mm_set1_epi32(1)), 30), high));
+  const __m128d qs = _mm_xor_pd(_mm_or_pd(_mm_andnot_pd(swap, s), _mm_and_pd(swap, co)), sign_s);
+  const __m128d qc = _mm_xor_pd(_mm_or_pd(_mm_andnot_pd(swap, co), _mm_and_pd(swap, s)), sign_c);
+  sx = {_mm_cvtsd_f64(qs), _mm_cvtsd_f64(qc)};
+  sy = {_mm_cvtsd_f64(_mm_unpackhi_pd(qs, qs)), _mm_cvtsd_f64(_mm_unpackhi_pd(qc, qc))};
 #else
   sx = sincos(x);
   sy = sincos(y);
