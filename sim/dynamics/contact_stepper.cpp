@@ -16,6 +16,7 @@ namespace dicesim {
 
 FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshold, double max_sink)
     : m_(&m),
+      moments_(m.principal_moments),
       h_max_(h),
       h_(h),
       v_impact_(sustained_contact_speed(m, h)),
@@ -204,7 +205,7 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   // impulse, the same angular momentum): it is reused.
   const TorqueFreeRotation& rot = built                             ? *slot
                                   : !full && c.n == 0 && full_rot_ ? *full_rot_
-                                                                    : slot.emplace(m.principal_moments, s.R,
+                                                                    : slot.emplace(moments_, s.R,
                                                                                    Vec3(Iw_start_ * s.omega), full);
   rot_start_ = s.R;
   const Vec3 p = s.position, v = s.velocity;
@@ -453,7 +454,7 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
   TorqueFreeRotation(m.principal_moments, mid.R, -(world_inertia(m, mid.R) * mid.omega)).state(tau, s.R, w_back);
   s.omega = -w_back;
   s.position = mid.position - tau * mid.velocity;
-  rot.emplace(m.principal_moments, s.R, world_inertia(m, s.R) * s.omega);
+  rot.emplace(moments_, s.R, world_inertia(m, s.R) * s.omega);
 }
 
 void FixedStepper::start_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
@@ -484,7 +485,7 @@ void FixedStepper::start_support(RigidState& s, const ContactSet& c, double d, d
     sweeps += a.sup.iterations;
     apply_rolling_resistance(m, s, c, a.sup.normal_impulse);
     apply_pivoting_resistance(m, s, c, a.sup.normal_impulse);
-    rot.emplace(m.principal_moments, s.R, world_inertia(m, s.R) * s.omega);
+    rot.emplace(moments_, s.R, world_inertia(m, s.R) * s.omega);
     const Vec3 z_row = rot->bottom_row(d);
     double gap = std::numeric_limits<double>::infinity();
     for (int r = 0; r < 2; ++r)

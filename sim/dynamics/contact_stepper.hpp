@@ -207,6 +207,7 @@ class FixedStepper {
   double lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row, const Vec3& z_rate,
                      double t, double& slope) const;
   const DieModel* m_;
+  TorqueFreeRotation::Moments moments_;  // the die's, for its many rotations' set-ups
   // The vertices by coordinate, for lowest_flat's vectorised pass (flat dice of up to
   // kSoaVertices corners; soa_vertices_ = 0: the plain loop).
   static constexpr int kSoaVertices = 64;

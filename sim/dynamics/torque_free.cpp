@@ -131,41 +131,50 @@ bool is_symmetric_top(const Vec3& moments) {
          nearly_equal(moments[0], moments[2]);
 }
 
-TorqueFreeRotation::TorqueFreeRotation(const Vec3& moments, const Mat3& R0, const Vec3& L_world, bool bounds)
-    : I_(moments), R0_(R0), L_(L_world) {
+TorqueFreeRotation::Moments::Moments(const Vec3& moments) : I(moments) {
+  const bool e01 = nearly_equal(I[0], I[1]), e12 = nearly_equal(I[1], I[2]), e02 = nearly_equal(I[0], I[2]);
+  if (!(e01 || e12 || e02)) {  // not is_symmetric_top(I)
+    general = true;
+    return;
+  }
+  const Vec3 a = I.cwiseInverse();
+  if (int(e01) + int(e12) + int(e02) >= 2) {
+    // A sphere (all three agree): pure rotation about L at |L|/I; the axis choice is immaterial.
+    const double a_mean = a.sum() / 3.0;
+    axis = 2, inv_I_axis = a_mean, inv_I_perp = a_mean;
+  } else if (e01) {
+    axis = 2, inv_I_axis = a[2], inv_I_perp = 0.5 * (a[0] + a[1]);
+  } else if (e12) {
+    axis = 0, inv_I_axis = a[0], inv_I_perp = 0.5 * (a[1] + a[2]);
+  } else {
+    axis = 1, inv_I_axis = a[1], inv_I_perp = 0.5 * (a[0] + a[2]);
+  }
+  p = (axis + 1) % 3;
+  q = (axis + 2) % 3;
+}
+
+TorqueFreeRotation::TorqueFreeRotation(const Moments& moments, const Mat3& R0, const Vec3& L_world, bool bounds)
+    : I_(moments.I), R0_(R0), L_(L_world) {
   if (L_.squaredNorm() == 0.0) {  // zero, or so small that |L|^2 underflows (omega ~ 0 anyway)
     kind_ = Kind::Still;
     return;
   }
   const Vec3 L_body = R0_.transpose() * L_;
-  const bool e01 = nearly_equal(I_[0], I_[1]), e12 = nearly_equal(I_[1], I_[2]),
-             e02 = nearly_equal(I_[0], I_[2]);
-  if (!(e01 || e12 || e02)) {  // not is_symmetric_top(I_)
+  if (moments.general) {
     kind_ = Kind::General;
     init_general(L_body, bounds);
     return;
   }
   kind_ = Kind::SymmetricTop;
-  const Vec3 a = I_.cwiseInverse();
-  if (int(e01) + int(e12) + int(e02) >= 2) {
-    // A sphere (all three agree): pure rotation about L at |L|/I; the axis choice is immaterial.
-    const double a_mean = a.sum() / 3.0;
-    init_symmetric(2, a_mean, a_mean, L_body, bounds);
-  } else if (e01) {
-    init_symmetric(2, a[2], 0.5 * (a[0] + a[1]), L_body, bounds);
-  } else if (e12) {
-    init_symmetric(0, a[0], 0.5 * (a[1] + a[2]), L_body, bounds);
-  } else {
-    init_symmetric(1, a[1], 0.5 * (a[0] + a[2]), L_body, bounds);
-  }
+  init_symmetric(moments.axis, moments.p, moments.q, moments.inv_I_axis, moments.inv_I_perp, L_body, bounds);
 }
 
-void TorqueFreeRotation::init_symmetric(int axis, double inv_I_axis, double inv_I_perp, const Vec3& L_body,
-                                        bool bounds) {
+void TorqueFreeRotation::init_symmetric(int axis, int p, int q, double inv_I_axis, double inv_I_perp,
+                                        const Vec3& L_body, bool bounds) {
   Symmetric& s = sym_;
   s.axis = axis;
-  s.p = (axis + 1) % 3;
-  s.q = (axis + 2) % 3;
+  s.p = p;
+  s.q = q;
   const double L_norm = L_.norm();
   const Vec3 L_hat = L_ / L_norm;
   s.precession_rate = L_norm * inv_I_perp;
@@ -190,6 +199,7 @@ void TorqueFreeRotation::init_symmetric(int axis, double inv_I_axis, double inv_
 
 void TorqueFreeRotation::init_general(const Vec3& L_body, bool bounds) {
   General& g = gen_;
+  g.steady = false;
   g.inv_I = I_.cwiseInverse();
   const Vec3& a = g.inv_I;
   const double L_norm = L_.norm();
@@ -198,7 +208,7 @@ void TorqueFreeRotation::init_general(const Vec3& L_body, bool bounds) {
   for (int i = 0; i < 3; ++i) {
     if (L_body[(i + 1) % 3] == 0.0 && L_body[(i + 2) % 3] == 0.0) {
       g.steady = true;
-      init_symmetric(i, a[i], a[i], L_body, bounds);
+      init_symmetric(i, (i + 1) % 3, (i + 2) % 3, a[i], a[i], L_body, bounds);
       return;
     }
   }
