@@ -101,16 +101,23 @@ namespace {
 struct CornerPass {
   double R[9];  // row-major
   double zc, vz, wx, wy, rounding, two_A;
+  double tol;   // a corner at most this high and moving down touches
 };
 
-void corner_pass(const CornerPass& c, int n, const double* vx, const double* vy, const double* vzs, double* z,
-                 double* zdot, double* num) {
+// Also returns whether any corner touches (z <= tol, zdot < 0) and, if none does, sets min_num to
+// the smallest numerator: the search's own loop (next_contact) would find the same number, the
+// minimum of values that are never NaN or -0 (zdot + sqrt(zdot^2 + ...) >= +0, or a tiny
+// negative where zdot^2 underflows), in any order. If one does, the loop runs as before.
+bool corner_pass(const CornerPass& c, int n, const double* vx, const double* vy, const double* vzs, double* z,
+                 double* zdot, double* num, double& min_num) {
 #if defined(__SSE2__)
   const __m128d r00 = _mm_set1_pd(c.R[0]), r01 = _mm_set1_pd(c.R[1]), r02 = _mm_set1_pd(c.R[2]);
   const __m128d r10 = _mm_set1_pd(c.R[3]), r11 = _mm_set1_pd(c.R[4]), r12 = _mm_set1_pd(c.R[5]);
   const __m128d r20 = _mm_set1_pd(c.R[6]), r21 = _mm_set1_pd(c.R[7]), r22 = _mm_set1_pd(c.R[8]);
   const __m128d zc = _mm_set1_pd(c.zc), vz = _mm_set1_pd(c.vz), wx = _mm_set1_pd(c.wx), wy = _mm_set1_pd(c.wy);
   const __m128d rounding = _mm_set1_pd(c.rounding), two_A = _mm_set1_pd(c.two_A), zero = _mm_setzero_pd();
+  const __m128d tol = _mm_set1_pd(c.tol);
+  __m128d touch = _mm_setzero_pd(), low = _mm_set1_pd(std::numeric_limits<double>::infinity());
   for (int i = 0; i < n; i += 2) {
     const __m128d x = _mm_load_pd(vx + i), y = _mm_load_pd(vy + i), w = _mm_load_pd(vzs + i);
     const __m128d px = _mm_add_pd(_mm_add_pd(_mm_mul_pd(r00, x), _mm_mul_pd(r01, y)), _mm_mul_pd(r02, w));
@@ -122,8 +129,17 @@ void corner_pass(const CornerPass& c, int n, const double* vx, const double* vy,
     const __m128d root = _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(zdi, zdi), _mm_mul_pd(two_A, zp)));
     _mm_store_pd(z + i, zi);
     _mm_store_pd(zdot + i, zdi);
-    _mm_store_pd(num + i, _mm_add_pd(zdi, root));
+    const __m128d ni = _mm_add_pd(zdi, root);
+    _mm_store_pd(num + i, ni);
+    // (The padding lane of an odd count repeats the last corner: nothing new. num < low ? num : low,
+    // as std::min(low, num); a touching corner's num too, but then the caller's loop decides.)
+    touch = _mm_or_pd(touch, _mm_and_pd(_mm_cmple_pd(zi, tol), _mm_cmplt_pd(zdi, zero)));
+    low = _mm_min_pd(ni, low);
   }
+  if (_mm_movemask_pd(touch) != 0) return true;
+  low = _mm_min_pd(low, _mm_unpackhi_pd(low, low));
+  min_num = _mm_cvtsd_f64(low);
+  return false;
 #else
   for (int i = 0; i < n; ++i) {
     const double px = (c.R[0] * vx[i] + c.R[1] * vy[i]) + c.R[2] * vzs[i];
@@ -133,6 +149,12 @@ void corner_pass(const CornerPass& c, int n, const double* vx, const double* vy,
     zdot[i] = c.vz + (c.wx * py - c.wy * px);
     num[i] = zdot[i] + std::sqrt(zdot[i] * zdot[i] + c.two_A * std::max(z[i], 0.0));
   }
+  min_num = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < n; ++i) {
+    if (z[i] <= c.tol && zdot[i] < 0.0) return true;
+    min_num = std::min(min_num, num[i]);
+  }
+  return false;
 #endif
 }
 
@@ -172,7 +194,9 @@ ContactSearch Flight::next_contact(double t_limit) const {
       const Vec3& v = model_->vertices[static_cast<std::size_t>(i)];
       cx[i] = v.x(), cy[i] = v.y(), cz[i] = v.z();
     }
-    if (n % 2 == 1) cx[n] = cy[n] = cz[n] = 0.0;  // a padding lane, computed and never read
+    // A padding lane, the last corner again: computed, never read one by one, and the same as
+    // that corner in corner_pass's minimum and touch test.
+    if (n % 2 == 1) cx[n] = cx[n - 1], cy[n] = cy[n - 1], cz[n] = cz[n - 1];
   }
   for (int it = 0; it < kMaxIterations; ++it) {
     out.iterations = it + 1;
@@ -226,17 +250,22 @@ ContactSearch Flight::next_contact(double t_limit) const {
     }
     if (soa) {
       const CornerPass pass{{R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)},
-                            zc, vz, w.x(), w.y(), rounding, 2.0 * A};
-      corner_pass(pass, n, cx, cy, cz, z_of, zdot_of, num_of);
-      for (int i = 0; i < n; ++i) {
-        if (z_of[i] <= contact_tol_ && zdot_of[i] < 0.0) {
-          if (z_of[i] < touching_z) {
-            touching = i;
-            touching_z = z_of[i];
+                            zc, vz, w.x(), w.y(), rounding, 2.0 * A, contact_tol_};
+      double min_num;
+      if (!corner_pass(pass, n, cx, cy, cz, z_of, zdot_of, num_of, min_num)) {
+        // No corner touching (every iteration but the last): the numerators' minimum from the pass.
+        numerator = std::min(numerator, min_num);
+      } else {
+        for (int i = 0; i < n; ++i) {
+          if (z_of[i] <= contact_tol_ && zdot_of[i] < 0.0) {
+            if (z_of[i] < touching_z) {
+              touching = i;
+              touching_z = z_of[i];
+            }
+            continue;
           }
-          continue;
+          numerator = std::min(numerator, num_of[i]);
         }
-        numerator = std::min(numerator, num_of[i]);
       }
     } else {
       for (int i = 0; i < n; ++i) {
