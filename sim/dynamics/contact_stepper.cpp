@@ -911,14 +911,16 @@ constexpr int kMaxTrials = 12;
 // Halvings of a curved die's step whose curvature impulse was capped (step()).
 constexpr int kMaxHalvings = 4;
 
-int FixedStepper::step(RigidState& s) {
+int FixedStepper::step(RigidState& s) { return step(s, kinetic_energy(*m_, s)); }
+
+int FixedStepper::step(RigidState& s, double ke) {
   const DieModel& m = *m_;
   ContactSet c;
   if (s.position.z() <= m.bounding_radius + touch_tol_) c = touching_corners(m, s, touch_tol_);
   const bool relanded = land_window_ > 0.0;  // this is the step taken again (below)
   if (m.curved() && c.n > 0) add_face_tripod(s, c, land_window_, land_depth_);
   land_window_ = land_depth_ = 0.0;
-  const double E0 = mechanical_energy(m, s);
+  const double E0 = ke + m.mass * m.gravity * s.position.z();  // mechanical_energy(m, s)
   // Impact first, at the instant of contact, on the velocity before gravity's kick: restitution
   // returns the approach speed the corner really had (after the kick it would return g h more,
   // and gain energy). Then (in each trial) gravity, then the plastic solve that holds the die up.
@@ -1210,7 +1212,7 @@ int FixedStepper::step(RigidState& s) {
         land_window_ = h_;
         land_depth_ = std::max(0.0, below);
         ++flat_landed;
-        return step(s);
+        return step(s, ke);
       }
     }
   }
@@ -1240,13 +1242,14 @@ int FixedStepper::step(RigidState& s) {
   dt_ = dt;
   slap_located_ = rims_new_ && dt < h_;
   if (slap_rims_ != 0 && dt < h_) ++slaps;
+  end_ke_ = kinetic_energy(m, s);
   if (a.risen) {
     // A step whose held corners rose: no gain in the rest rules' energy, which adds the deepest
     // corner's depth to the COM height (try_step's check).
     max_energy_gain =
         std::max(max_energy_gain, relative_gain(E0 + m.mass * m.gravity * start_depth_max_, a.held_e));
   } else {
-    max_energy_gain = std::max(max_energy_gain, relative_gain(E0, mechanical_energy(m, s)));
+    max_energy_gain = std::max(max_energy_gain, relative_gain(E0, end_ke_ + m.mass * m.gravity * s.position.z()));
   }
   if (a.rise_dropped) ++rise_dropped;
   if (m.curved()) {
@@ -1304,8 +1307,11 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
     }
     return out;
   };
+  // The kinetic energy of s, kept up to date (the rest check, the step and the balance test below
+  // all read it; each step hands back its end's).
+  double ke = kinetic_energy(m, s);
   for (long long k = 0; k < max_steps && t < m.max_time; ++k) {
-    const int f = rest_face_down(m, s, tiebreak);
+    const int f = rest_face_down(m, s, tiebreak, ke);
     if (f >= 0) {
       out.face_down = f;
       return finish(StepperExit::Settled);
@@ -1313,12 +1319,14 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
     if (!allow_liftoff) {  // `stepped`: a flight high above the floor in closed form
       const long long coasted = st.coast(s, t, m.max_time, max_steps - k - 1);
       if (coasted > 0) {
+        ke = kinetic_energy(m, s);
         k += coasted;
         steps += static_cast<std::uint64_t>(coasted);
         if (!(k < max_steps && t < m.max_time)) break;
       }
     }
-    const int n = st.step(s);
+    const int n = st.step(s, ke);
+    ke = st.end_ke();
     ++steps;
     t += st.last_dt();
     if (st.impacts >= m.max_bounces) break;
@@ -1337,8 +1345,6 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       continue;
     }
     // At rest but undecided: an exact balance on an edge or a corner. Break it the toss's way.
-    const Vec3 wb = s.R.transpose() * s.omega;
-    const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
     if (ke < ke_rest && out.nudges < 4) {
       const ContactSet c = touching_corners(m, s, 1e-6 * r);
       Vec3 axis;
@@ -1351,6 +1357,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
         axis = Vec3(a.cos, a.sin, 0.0);
       }
       s.omega += nudge * axis;
+      ke = kinetic_energy(m, s);
       ++out.nudges;
     }
   }

@@ -66,6 +66,11 @@ class FixedStepper {
   // floor first (last_dt()).
   // Returns the number of corners that were in contact at the step's start.
   int step(RigidState& s);
+  // The same given ke = kinetic_energy(m, s) (contact.hpp); end_ke() is then the kinetic energy of
+  // s as the step leaves it (a curved die's lift at the end moves only its position): the stepper's
+  // loop hands it to the rest check and to the next step instead of computing it again.
+  int step(RigidState& s, double ke);
+  double end_ke() const { return end_ke_; }
 
   // `stepped`'s flights in closed form: from s, with the COM at least the bounding radius above
   // the floor, the number K <= max_k of whole steps (each h) after which every step's start and
@@ -226,6 +231,7 @@ class FixedStepper {
   double a_down_ = 0.0;
   double v_spin_ = 0.0;  // Contact: 4 h r, the factor of |w|^2 in the threshold
   double dt_ = 0.0;
+  double end_ke_ = 0.0;  // step(): the kinetic energy of the state it returns
   Mat3 rot_start_ = Mat3::Identity();  // orientation at the start of the step being tried
   Mat3 Iw_start_ = Mat3::Identity();   // its world inertia (every trial's angular momentum)
   double e_start_ = 0.0;                // its mechanical energy after the impact (the trials' checks)

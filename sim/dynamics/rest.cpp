@@ -227,6 +227,11 @@ int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) {
   if (m.curved()) return rim_rest_face_down(m, s, tiebreak);
   const Vec3 wb = s.R.transpose() * s.omega;
   const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
+  return rest_face_down(m, s, tiebreak, ke);
+}
+
+int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, double ke) {
+  if (m.curved()) return rim_rest_face_down(m, s, tiebreak, ke);
   const double mg = m.mass * m.gravity;
   // Energy above every basin's barrier and no corner can reach the floor: neither criterion can
   // hold (cheap; the flights' and the air steps' rest checks end here).

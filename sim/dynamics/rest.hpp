@@ -61,6 +61,8 @@ int roll_from_face(const DieModel& m, int f, double tiebreak);
 //    Die 1 `impulse` toss spent 11.6 of its 63 contact steps sliding flat on a face, already
 //    decided. The gate now only ends the check when no corner can reach the floor either.)
 int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak);
+// The same given ke = kinetic_energy(m, s) (contact.hpp), for a caller that has it already.
+int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, double ke);
 
 // The face that is read when face f lies on the floor (the face up, or f for a die read down).
 inline int result_face(const DieModel& m, int f) { return m.face_result[static_cast<std::size_t>(f)]; }

@@ -86,6 +86,10 @@ int rim_quasi_static_down(const DieModel& m, const Mat3& R, double tiebreak) {
 int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) {
   const Vec3 wb = s.R.transpose() * s.omega;
   const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
+  return rim_rest_face_down(m, s, tiebreak, ke);
+}
+
+int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, double ke) {
   const double mg = m.mass * m.gravity;
   // Above every barrier: only lying flat can decide, and only with a rim point on the floor.
   const bool above_barriers = ke + mg * s.position.z() >= mg * m.max_escape;

@@ -29,6 +29,8 @@ int rim_quasi_static_down(const DieModel& m, const Mat3& R, double tiebreak);
 
 // The face the die must come to rest on (energy below its basin's saddle), or -1.
 int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak);
+// The same given ke = kinetic_energy(m, s) (contact.hpp).
+int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, double ke);
 
 // Lowest contact-feature height relative to the COM (world z) over features not in c.
 double rim_lowest_excluding(const DieModel& m, const Mat3& R, const ContactSet& c);
