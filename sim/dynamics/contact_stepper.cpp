@@ -12,6 +12,10 @@
 #include "sim/illinois.hpp"
 #include "sim/sincos.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace dicesim {
 
 FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshold, double max_sink)
@@ -38,6 +42,7 @@ FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshol
       vy_[i] = m.vertices[static_cast<std::size_t>(i)].y();
       vz_[i] = m.vertices[static_cast<std::size_t>(i)].z();
     }
+    if (nv % 2 == 1) vx_[nv] = vx_[nv - 1], vy_[nv] = vy_[nv - 1], vz_[nv] = vz_[nv - 1];
   }
 }
 
@@ -96,18 +101,40 @@ double FixedStepper::slap_low(const Vec3& z_row, int rim) const {
   return base - m.rims.radius * drop;
 }
 
+double FixedStepper::soa_heights(const ContactSet& c, const Vec3& z_row, double* z) const {
+  const int nv = soa_vertices_;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+#if defined(__SSE2__)
+  const __m128d zx = _mm_set1_pd(z_row.x()), zy = _mm_set1_pd(z_row.y()), zz = _mm_set1_pd(z_row.z());
+  for (int i = 0; i < nv; i += 2) {
+    const __m128d h = _mm_add_pd(_mm_add_pd(_mm_mul_pd(zx, _mm_load_pd(vx_ + i)), _mm_mul_pd(zy, _mm_load_pd(vy_ + i))),
+                                 _mm_mul_pd(zz, _mm_load_pd(vz_ + i)));
+    _mm_store_pd(z + i, h);
+  }
+  for (int k = 0; k < c.n; ++k) z[c.vertex[k]] = kInf;
+  if (nv % 2 == 1) z[nv] = z[nv - 1];  // the padding lane: the last vertex again, masked or not
+  // The minimum of finite heights (never -0: a height is -0 only if all three products are) is
+  // the same number in any order: two lanes, then the two (z < low ? z : low, as std::min).
+  __m128d low = _mm_set1_pd(kInf);
+  for (int i = 0; i < nv; i += 2) low = _mm_min_pd(_mm_load_pd(z + i), low);
+  return _mm_cvtsd_f64(_mm_min_pd(_mm_unpackhi_pd(low, low), low));
+#else
+  const double zx = z_row.x(), zy = z_row.y(), zz = z_row.z();
+  for (int i = 0; i < nv; ++i) z[i] = (zx * vx_[i] + zy * vy_[i]) + zz * vz_[i];
+  for (int k = 0; k < c.n; ++k) z[c.vertex[k]] = kInf;
+  double low = kInf;
+  for (int i = 0; i < nv; ++i) low = std::min(low, z[i]);
+  return low;
+#endif
+}
+
 double FixedStepper::lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row, double t) const {
   if (soa_vertices_ > 0) {
-    // Every corner's height in one vectorisable pass (the same products and sums, in the same
-    // order, as z_row.dot(vertex)), the contact set's corners masked out, then the minimum in
-    // vertex order: the same number as the loop below.
-    const int nv = soa_vertices_;
-    const double zx = z_row.x(), zy = z_row.y(), zz = z_row.z();
-    double z[kSoaVertices];
-    for (int i = 0; i < nv; ++i) z[i] = (zx * vx_[i] + zy * vy_[i]) + zz * vz_[i];
-    for (int k = 0; k < c.n; ++k) z[c.vertex[k]] = std::numeric_limits<double>::infinity();
-    double low = std::numeric_limits<double>::infinity();
-    for (int i = 0; i < nv; ++i) low = std::min(low, z[i]);
+    // Every corner's height two at a time (the same products and sums, in the same order, as
+    // z_row.dot(vertex)), the contact set's corners masked out, and their minimum: the same
+    // number as the loop below.
+    alignas(16) double z[kSoaVertices];
+    const double low = soa_heights(c, z_row, z);
     return p.z() + v.z() * t + low - m_->rounding;
   }
   const auto& verts = m_->vertices;
@@ -126,6 +153,18 @@ double FixedStepper::lowest_flat(const ContactSet& c, const Vec3& p, const Vec3&
 
 double FixedStepper::lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row,
                                  const Vec3& z_rate, double t, double& slope) const {
+  if (soa_vertices_ > 0) {
+    // As the loop below: the lowest corner's height, and its rate from the first corner (in vertex
+    // order) at that height (the loop's strict < keeps the first).
+    alignas(16) double z[kSoaVertices];
+    const double low = soa_heights(c, z_row, z);
+    int arg = -1;
+    if (low < std::numeric_limits<double>::infinity())
+      for (int i = 0; arg < 0; ++i)
+        if (z[i] == low) arg = i;
+    slope = v.z() + (arg >= 0 ? z_rate.dot(m_->vertices[static_cast<std::size_t>(arg)]) : 0.0);
+    return p.z() + v.z() * t + low - m_->rounding;
+  }
   const auto& verts = m_->vertices;
   const int nv = static_cast<int>(verts.size());
   double low = std::numeric_limits<double>::infinity();

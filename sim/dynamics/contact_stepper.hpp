@@ -217,7 +217,12 @@ class FixedStepper {
   // kSoaVertices corners; soa_vertices_ = 0: the plain loop).
   static constexpr int kSoaVertices = 64;
   int soa_vertices_ = 0;
-  double vx_[kSoaVertices], vy_[kSoaVertices], vz_[kSoaVertices];
+  // (An odd count is padded with the last vertex again, for the two-at-a-time pass.)
+  alignas(16) double vx_[kSoaVertices], vy_[kSoaVertices], vz_[kSoaVertices];
+  // The heights relative to the COM of every vertex for the bottom row z_row (the same products
+  // and sums, in the same order, as z_row.dot(vertex)) into z (padded as vx_), the contact set's
+  // corners as +inf; returns their minimum (+inf if every corner is in c).
+  double soa_heights(const ContactSet& c, const Vec3& z_row, double* z) const;
   double h_max_;  // the contact step h (thresholds, coast)
   double h_;      // the current step's full length (h_max_, or shorter for max_sink_)
   double v_impact_, touch_tol_;
