@@ -128,6 +128,38 @@ double FixedStepper::soa_heights(const ContactSet& c, const Vec3& z_row, double*
 #endif
 }
 
+bool FixedStepper::soa_touching(const RigidState& s, ContactSet& c) const {
+  const int nv = soa_vertices_;
+  const double rounding = m_->rounding, tol = touch_tol_, pz = s.position.z();
+  const double r20 = s.R(2, 0), r21 = s.R(2, 1), r22 = s.R(2, 2);
+  int n = 0;
+#if defined(__SSE2__)
+  const __m128d x = _mm_set1_pd(r20), y = _mm_set1_pd(r21), z = _mm_set1_pd(r22);
+  const __m128d p = _mm_set1_pd(pz), r = _mm_set1_pd(rounding), t = _mm_set1_pd(tol);
+  for (int i = 0; i < nv; i += 2) {
+    const __m128d h = _mm_sub_pd(
+        _mm_add_pd(p, _mm_add_pd(_mm_mul_pd(x, _mm_load_pd(vx_ + i)),
+                                 _mm_add_pd(_mm_mul_pd(y, _mm_load_pd(vy_ + i)), _mm_mul_pd(z, _mm_load_pd(vz_ + i))))),
+        r);
+    // touching_corners keeps a corner unless its height > tol (NaN included): not-greater-than.
+    const int bits = _mm_movemask_pd(_mm_cmpngt_pd(h, t));
+    if (bits == 0) continue;
+    if (n + 2 > kMaxContacts) return false;
+    if (bits & 1) c.vertex[n++] = i;
+    if ((bits & 2) && i + 1 < nv) c.vertex[n++] = i + 1;  // (not an odd count's padding lane)
+  }
+#else
+  for (int i = 0; i < nv; ++i) {
+    const double h = (pz + (r20 * vx_[i] + (r21 * vy_[i] + r22 * vz_[i]))) - rounding;
+    if (h > tol) continue;
+    if (n + 1 > kMaxContacts) return false;
+    c.vertex[n++] = i;
+  }
+#endif
+  c.n = n;
+  return true;
+}
+
 double FixedStepper::lowest_flat(const ContactSet& c, const Vec3& p, const Vec3& v, const Vec3& z_row, double t) const {
   if (soa_vertices_ > 0) {
     // Every corner's height two at a time (the same products and sums, in the same order, as
@@ -955,7 +987,8 @@ int FixedStepper::step(RigidState& s) { return step(s, kinetic_energy(*m_, s)); 
 int FixedStepper::step(RigidState& s, double ke) {
   const DieModel& m = *m_;
   ContactSet c;
-  if (s.position.z() <= m.bounding_radius + touch_tol_) c = touching_corners(m, s, touch_tol_);
+  if (s.position.z() <= m.bounding_radius + touch_tol_ && !(soa_vertices_ > 0 && soa_touching(s, c)))
+    c = touching_corners(m, s, touch_tol_);
   const bool relanded = land_window_ > 0.0;  // this is the step taken again (below)
   if (m.curved() && c.n > 0) add_face_tripod(s, c, land_window_, land_depth_);
   land_window_ = land_depth_ = 0.0;

@@ -223,6 +223,11 @@ class FixedStepper {
   // and sums, in the same order, as z_row.dot(vertex)) into z (padded as vx_), the contact set's
   // corners as +inf; returns their minimum (+inf if every corner is in c).
   double soa_heights(const ContactSet& c, const Vec3& z_row, double* z) const;
+  // touching_corners(m, s, touch_tol_) from the same arrays, two corners at a time: the same
+  // heights (corner_height's (p_z + (R20 x + (R21 y + R22 z))) - rounding), the same set in
+  // ascending order, into c (as a fresh ContactSet). False if more than kMaxContacts touch (c
+  // then partly filled: the caller takes touching_corners).
+  bool soa_touching(const RigidState& s, ContactSet& c) const;
   double h_max_;  // the contact step h (thresholds, coast)
   double h_;      // the current step's full length (h_max_, or shorter for max_sink_)
   double v_impact_, touch_tol_;
