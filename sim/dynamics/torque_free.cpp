@@ -373,18 +373,17 @@ TorqueFreeRotation::JacobiState TorqueFreeRotation::jacobi_state(double t) const
   return js;
 }
 
-Mat3 TorqueFreeRotation::symmetric_orientation(double t) const {
+void TorqueFreeRotation::symmetric_orientation(double t, Mat3& R) const {
   const Symmetric& s = sym_;
   SinCos a, b;  // both angles in one SSE2 pass: the same numbers as two sincos calls
   sincos2(s.precession_rate * t, s.spin_rate * t, a, b);
-  Mat3 R = s.along + a.cos * s.across + a.sin * s.cross;
+  R = s.along + a.cos * s.across + a.sin * s.cross;
   if (s.spin_rate != 0.0) {
     const double cb = b.cos, sb = b.sin;
     const Vec3 col_p = R.col(s.p), col_q = R.col(s.q);
     R.col(s.p) = cb * col_p + sb * col_q;
     R.col(s.q) = cb * col_q - sb * col_p;
   }
-  return R;
 }
 
 Mat3 TorqueFreeRotation::general_orientation(const JacobiState& js, double t, Vec3* L_body) const {
@@ -490,7 +489,7 @@ void TorqueFreeRotation::state(double t, Mat3& R, Vec3& omega_world) const {
   }
   if (kind_ == Kind::SymmetricTop || gen_.steady) {
     // omega_b = a_perp L_b + (a_a - a_perp) L_a e_a, so omega_world = a_perp L + spin_rate R e_a.
-    R = symmetric_orientation(t);
+    symmetric_orientation(t, R);
     omega_world = sym_.inv_I_perp * L_ + sym_.spin_rate * R.col(sym_.axis);
     return;
   }

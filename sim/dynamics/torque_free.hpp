@@ -110,7 +110,13 @@ class TorqueFreeRotation {
   void init_symmetric(int axis, int p, int q, double inv_I_axis, double inv_I_perp, const Vec3& L_body, bool bounds);
   void init_general(const Vec3& L_body, bool bounds);
   JacobiState jacobi_state(double t) const;
-  Mat3 symmetric_orientation(double t) const;
+  // (Into R: state() hands its caller's matrix, no copy of a returned one.)
+  void symmetric_orientation(double t, Mat3& R) const;
+  Mat3 symmetric_orientation(double t) const {
+    Mat3 R;
+    symmetric_orientation(t, R);
+    return R;
+  }
   Mat3 general_orientation(const JacobiState& js, double t, Vec3* L_body) const;
 };
 
