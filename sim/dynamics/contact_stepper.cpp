@@ -289,23 +289,20 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   // The step's end orientation is evaluated once: its bottom row is bit for bit the one
   // bottom_row(d) returns (the same operations on the same row), so a flat die's corner heights
   // come from it (a curved die's rim, and d = 0, keep lowest_new's own evaluation).
-  Mat3 R_end;
-  Vec3 w;
-  rot.state(d, R_end, w);
-  if (full && clear > 0.0)
-    a.G = clear;
-  else if (m.curved() || d == 0.0)
-    a.G = lowest_new(c, p, v, rot, d);
-  else
-    a.G = lowest_flat(c, p, v, R_end.row(2).transpose(), d);
+  // (Written straight into s: rot holds its own copy of the start.)
   if (full) {
     full_p_ = p;
     full_v_ = v;
     full_w_ = s.omega;
   }
+  rot.state(d, s.R, s.omega);
+  if (full && clear > 0.0)
+    a.G = clear;
+  else if (m.curved() || d == 0.0)
+    a.G = lowest_new(c, p, v, rot, d);
+  else
+    a.G = lowest_flat(c, p, v, s.R.row(2).transpose(), d);
   s.position = p + d * v;
-  s.R = R_end;
-  s.omega = w;
   if (!(bias > 0.0)) return true;
   // (New corners below the floor are the located step's business.)
   a.held_e = held_energy(s, c);
