@@ -13,7 +13,12 @@ namespace dicesim {
 // Unit vector in rim plane (perpendicular to the world axis K) pointing most nearly down; a fixed
 // body direction when the axis is vertical (then every rim point is equally low).
 inline Vec3 rim_down(const DieModel& m, const Mat3& R, const Vec3& K) {
-  Vec3 u(K.z() * K.x(), K.z() * K.y(), K.z() * K.z() - 1.0);  // -e_z minus its component along K
+  // -e_z minus its component along K. Its z, K_z^2 - 1 = -(K_x^2 + K_y^2) for a unit K, is taken
+  // from K_x and K_y where rounding (|K| a little above 1) leaves K_z^2 >= 1 at a tilt of ~1e-8:
+  // the point found was then the rim's highest, its tripod 120 deg either side the lowest (a
+  // three-sided coin landing flat in `stepped`, toss 96416: the face was not seen, kind B).
+  const double kz2 = K.z() * K.z() - 1.0;
+  Vec3 u(K.z() * K.x(), K.z() * K.y(), kz2 < 0.0 ? kz2 : -(K.x() * K.x() + K.y() * K.y()));
   const double n = u.norm();
   if (n < 1e-12) return R * m.rims.perp;
   return u / n;

@@ -896,7 +896,8 @@ long long FixedStepper::coast(RigidState& s, double& t, double max_time, long lo
   return static_cast<long long>(k);
 }
 
-void FixedStepper::add_face_tripod(const RigidState& s, ContactSet& c, double window, double depth) const {
+void FixedStepper::add_face_tripod(const RigidState& s, ContactSet& c, double window, double depth,
+                                   bool either) const {
   // A coin flat to within ~1e-7 rad (a slap's located end: the far half arrives as the tilt
   // passes zero) touches with its whole face, but the features 120 deg either side of the rim's
   // lowest point sit 1.5 a tilt above it, just outside the touch tolerance: the contact set was the
@@ -921,7 +922,7 @@ void FixedStepper::add_face_tripod(const RigidState& s, ContactSet& c, double wi
       in2 = in2 || c.vertex[i] == 3 * r + 2;
     }
     if (!low || (in1 && in2)) continue;
-    if (!joins(3 * r + 1) || !joins(3 * r + 2)) continue;
+    if (either ? !(joins(3 * r + 1) || joins(3 * r + 2)) : !(joins(3 * r + 1) && joins(3 * r + 2))) continue;
     if (!in1 && c.n < kMaxContacts) c.vertex[c.n++] = 3 * r + 1;
     if (!in2 && c.n < kMaxContacts) c.vertex[c.n++] = 3 * r + 2;
   }
@@ -987,8 +988,9 @@ int FixedStepper::step(RigidState& s, double ke) {
   if (s.position.z() <= m.bounding_radius + touch_tol_ && !(soa_vertices_ > 0 && soa_touching(s, c)))
     c = touching_corners(m, s, touch_tol_);
   const bool relanded = land_window_ > 0.0;  // this is the step taken again (below)
-  if (m.curved() && c.n > 0) add_face_tripod(s, c, land_window_, land_depth_);
+  if (m.curved() && c.n > 0) add_face_tripod(s, c, land_window_, land_depth_, land_either_);
   land_window_ = land_depth_ = 0.0;
+  land_either_ = false;
   const double E0 = ke + m.mass * m.gravity * s.position.z();  // mechanical_energy(m, s)
   // Impact first, at the instant of contact, on the velocity before gravity's kick: restitution
   // returns the approach speed the corner really had (after the kick it would return g h more,
@@ -1274,9 +1276,45 @@ int FixedStepper::step(RigidState& s, double ke) {
     // tripod in the contact set: struck at once, as a polyhedron's landing face is (what it
     // closes early is what the step would close anyway, at most the lift it replaces). Once. (The
     // discarded attempt's work counters, located, halved and the slap's, stay counted.)
-    if (done->to_halve() || below > touch_tol_) {
+    if (done->to_halve() || done->clamped || below > touch_tol_) {
       ContactSet wide = c;
       add_face_tripod(s, wide, h_, std::max(0.0, below));
+      // Kind B (issue 13): the accepted step still clamps after the halvings, the coin within a
+      // few mrad of flat, tumbling at 30-80 rad/s about a nearly horizontal axis: its rim's
+      // lowest point jumps across the face within microseconds (a = 12 mm, tilt 3e-4, 46 rad/s:
+      // the curvature of its height is a w^2 / tilt ~ 1e5 m/s^2), which no step of the halvings
+      // (62.5 us) holds with an impulse that does no work. That is the face coming down: one
+      // tripod point descends at ~a w (0.4-1 m/s, 0.5-65 um up) while the other rises, so the
+      // rule above (both arriving) does not take it. It is struck as a face, the tripod joining
+      // when one of its points reaches the floor within the step (the rising one takes an
+      // impulse only if the strike turns it down). Kept only if the step taken again does better
+      // than the clamp (and lift) it replaces: the tripod does not cover the arcs between its
+      // points, and a face struck while an arc still comes down (a slap's face struck at 1 m/s,
+      // CylinderImpulse.SlappingFaceIsStruck) can clamp and lift again; the stepper's state is
+      // then restored and the step finished as it was.
+      if (wide.n == c.n && done->clamped) {
+        add_face_tripod(s, wide, h_, std::max(0.0, below), /*either=*/true);
+        if (wide.n > c.n) {
+          const auto count = [](const Corrections& k) {
+            return k.energy_clamps + k.overlap_fixes + k.pgs_unconverged + k.fallbacks;
+          };
+          const FixedStepper kept = *this;  // (rare: a few in 10^4 tosses)
+          const RigidState s_in = s;
+          const auto before = count(corrections);
+          land_window_ = h_;
+          land_depth_ = std::max(0.0, below);
+          land_either_ = true;
+          ++flat_landed;
+          const int n = step(s);
+          if (count(corrections) - before < (below > touch_tol_ ? 2u : 1u)) {
+            ++face_jumped;
+            return n;
+          }
+          *this = kept;
+          s = s_in;
+          ++face_jump_declined;
+        }
+      }
       if (wide.n > c.n) {
         land_window_ = h_;
         land_depth_ = std::max(0.0, below);
@@ -1366,6 +1404,8 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->slap_no_arrival += st.slap_no_arrival;
       stats->slap_rim_below += st.slap_rim_below;
       stats->flat_landed += st.flat_landed;
+      stats->face_jumped += st.face_jumped;
+      stats->face_jump_declined += st.face_jump_declined;
       stats->depth_held += st.depth_held;
       stats->dual_solves += st.dual_solves;
       stats->max_held_sink = std::max(stats->max_held_sink, st.max_held_sink);

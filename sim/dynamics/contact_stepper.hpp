@@ -106,6 +106,11 @@ class FixedStepper {
   // taken again from their start with the face's tripod struck because it reaches the floor
   // within the step or lies that close (step(): a coin landing or lying nearly flat).
   std::uint64_t flat_landed = 0;
+  // Curved dice: of those, the steps whose curvature impulse gained by its own work after the
+  // halvings (kind B, issue 13: a near-flat coin's lowest point jumping across the face) and whose
+  // face arrives within the step at one tripod point (the other may be rising).
+  std::uint64_t face_jumped = 0;
+  std::uint64_t face_jump_declined = 0;  // ... taken again but not kept (it clamped or lifted again)
   // Curved dice: curvature impulses that held a start's depth below the floor (within the touch
   // tolerance) because closing it within the step would gain energy (curvature_support).
   std::uint64_t depth_held = 0;
@@ -151,7 +156,9 @@ class FixedStepper {
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
   // A curved die lying flat to within the strike tolerance: its face's tripod added to c (also
   // when each tripod point lies within `depth` or reaches the floor within `window`: step()).
-  void add_face_tripod(const RigidState& s, ContactSet& c, double window = 0.0, double depth = 0.0) const;
+  // either: one tripod point joining suffices (both are added; step()'s kind B re-decision).
+  void add_face_tripod(const RigidState& s, ContactSet& c, double window = 0.0, double depth = 0.0,
+                       bool either = false) const;
   // try_step with the held corners asked to rise at `bias` (m/s, 0: none); false if that gains
   // energy (kinetic + m g (COM height + the deepest corner's depth)).
   bool try_step_with(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full, double bias);
@@ -279,6 +286,7 @@ class FixedStepper {
   // Set (window = the full step, > 0) when step() takes a step again with the face's tripod struck
   // (a coin landing or lying nearly flat): its next call widens add_face_tripod by these, once.
   double land_window_ = 0.0, land_depth_ = 0.0;
+  bool land_either_ = false;  // ... with one tripod point arriving enough (a kind B step)
   Vec3 free_end_row_ = Vec3::Zero();  // the full step's bottom row at its end, after the start's solve only
   double slap_u_[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
   bool impact_ = false;   // the current step starts with an impact (solved once for all its trials)
@@ -310,6 +318,8 @@ struct StepperStats {
   std::uint64_t slap_no_arrival = 0;  // a slap's far half did not arrive: the plain step taken
   std::uint64_t slap_rim_below = 0;   // a located slap left the rest of the rim below: the plain search again
   std::uint64_t flat_landed = 0;      // steps taken again with a nearly flat face's tripod struck
+  std::uint64_t face_jumped = 0;      // ... of them kind B steps (a near-flat coin's lowest point jumping)
+  std::uint64_t face_jump_declined = 0;  // kind B steps taken again with the face struck, not kept
   std::uint64_t depth_held = 0;       // curvature impulses that held a start's depth (closing it gained)
   std::uint64_t dual_solves = 0;      // impacts whose restitution friction the dual solve took
   // Flat dice (not corrections: a step's discretisation, reported): the deepest held corner below

@@ -32,6 +32,8 @@ inline void add_stepper_stats(TossProbe& probe, const StepperStats& stats) {
   probe.slap_no_arrival += stats.slap_no_arrival;
   probe.slap_rim_below += stats.slap_rim_below;
   probe.flat_landed += stats.flat_landed;
+  probe.face_jumped += stats.face_jumped;
+  probe.face_jump_declined += stats.face_jump_declined;
   probe.depth_held += stats.depth_held;
   probe.dual_solves += stats.dual_solves;
 }
