@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "sim/dynamics/contact.hpp"
 #include "sim/dynamics/rim_rest.hpp"
 #include "sim/sincos.hpp"
 
@@ -224,10 +225,7 @@ int roll_from_face(const DieModel& m, int f, double tiebreak) {
 }
 
 int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) {
-  if (m.curved()) return rim_rest_face_down(m, s, tiebreak);
-  const Vec3 wb = s.R.transpose() * s.omega;
-  const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
-  return rest_face_down(m, s, tiebreak, ke);
+  return rest_face_down(m, s, tiebreak, kinetic_energy(m, s));
 }
 
 int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, double ke) {

@@ -84,9 +84,7 @@ int rim_quasi_static_down(const DieModel& m, const Mat3& R, double tiebreak) {
 }
 
 int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) {
-  const Vec3 wb = s.R.transpose() * s.omega;
-  const double ke = 0.5 * m.mass * s.velocity.squaredNorm() + 0.5 * wb.dot(m.principal_moments.cwiseProduct(wb));
-  return rim_rest_face_down(m, s, tiebreak, ke);
+  return rim_rest_face_down(m, s, tiebreak, kinetic_energy(m, s));
 }
 
 int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, double ke) {

@@ -47,6 +47,9 @@ worker() { nworkers=$((nworkers + 1)); "$bin" worker --once "$@" 2> "$work/worke
 # Waits (up to 20 s) until workers 1..k have subscribed, so that a short run cannot end before one
 # of them hears it: "did worker k toss?" is then a question about leasing, not process start-up.
 listening() { for ((t = 0; t < 200; t++)); do [ "$(cat "$work"/worker*.err 2>/dev/null | grep -c "listening on")" -ge "$1" ] && return 0; sleep 0.1; done; fail "workers not listening after 20 s"; }
+# A worker logs "ended: finished" when it hears the aggregator's final message, which can be a
+# moment after the aggregator (or sweep) has exited: waits up to 10 s until FILE holds N such lines.
+ended_finished() { for ((t = 0; t < 100; t++)); do [ "$(grep -cE "ended: finished${3:-}" "$1")" -ge "$2" ] && return 0; sleep 0.1; done; return 1; }
 aggregate() { "$bin" aggregate "$scene" --tosses "$n" --seed "$seed" --json --timeout 150 "$@" > "$work/out.json" 2> "$work/agg.err"; }
 
 case "$scenario" in
@@ -57,7 +60,7 @@ case "$scenario" in
     listening 3
     aggregate || fail "aggregate exited $?"
     same_as_reference "$work/out.json"
-    for i in 1 2 3; do grep -qE "ended: finished \([1-9][0-9]* tosses" "$work/worker$i.err" || fail "worker $i did no tosses"; done
+    for i in 1 2 3; do ended_finished "$work/worker$i.err" 1 " \\([1-9][0-9]* tosses" || fail "worker $i did no tosses"; done
     ;;
   kill9)
     n=1000000
@@ -100,7 +103,7 @@ case "$scenario" in
     wait "$agg" || fail "aggregate exited $?"
     same_as_reference "$work/out.json"
     [ "$(health duplicates "$work/agg.err")" -gt 0 ] || fail "no duplicates seen: the replay tested nothing"
-    grep -qE "ended: finished \([1-9][0-9]* tosses" "$work/worker3.err" || fail "the restarted worker did no tosses"
+    ended_finished "$work/worker3.err" 1 " \\([1-9][0-9]* tosses" || fail "the restarted worker did no tosses"
     ;;
   late_join)
     n=600000
@@ -162,7 +165,7 @@ case "$scenario" in
     "$bin" sweep "$scene" "${sweep_args[@]}" --workers 0 --lcm "$url" > "$work/out0.json" 2> "$work/sweep0.err" ||
       fail "dicesim sweep --workers 0 --lcm exited $?"
     [ "$(strip "$work/ref.json")" = "$(strip "$work/out0.json")" ] || fail "outside-worker sweep counts differ from the in-process sweep"
-    [ "$(grep -c "ended: finished" "$work/worker1.err")" = 2 ] || fail "the outside worker did not serve both points"
+    ended_finished "$work/worker1.err" 2 || fail "the outside worker did not serve both points"
     "$bin" sweep "$scene" "${sweep_args[@]}" --workers 1 --lcm "$url" > "$work/out.json" 2> "$work/sweep.err" ||
       fail "dicesim sweep --workers exited $?"
     [ "$(strip "$work/ref.json")" = "$(strip "$work/out.json")" ] || fail "distributed sweep counts differ from the in-process sweep"

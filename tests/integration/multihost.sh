@@ -93,7 +93,9 @@ workers() {
     pids+=($!)
   done
 }
-tossed() { grep -qE "ended: finished \([1-9][0-9]* tosses" "$work/worker$1.err"; }
+# A worker logs its run's end when it hears the aggregator's final message, which can come a
+# moment after the aggregator has exited: waits up to 10 s for the line.
+tossed() { for ((t = 0; t < 100; t++)); do grep -qE "ended: finished \([1-9][0-9]* tosses" "$work/worker$1.err" && return 0; sleep 0.1; done; return 1; }
 
 case "$scenario" in
   lan)
