@@ -800,6 +800,21 @@ TEST(CylinderStepped, NearFlatCurvatureImpulseIsHalvedNotClamped) {
   expect_repaired(m, {869u, 1829u}, &TossProbe::halved);
 }
 
+// A coin on its side whose two rims' points touch, one about to lift while the other slides: the
+// sweeps stall there (the pair's 0.975-correlated normal rows), and none of the pair's exact cases
+// verified: solve_sliding's iterate changed its active set after its first pass, and the one-point
+// case with the other lifting was rejected because the lifting point slips (plastic_verifies
+// asked friction of a point with no normal impulse). Quarter `stepped` toss 79149 (seed 1), the
+// one unconverged solve of its 10^5 tosses; it read pgs_unconverged 1 before.
+TEST(CylinderStepped, CoinOnItsSideOnePointLiftingSolvesExactly) {
+  const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter.toml",
+                                        {"sim.fidelity=\"stepped\""}));
+  const TossResult r = toss(m, 1, 79149);
+  EXPECT_EQ(r.status, TossStatus::Settled);
+  EXPECT_EQ(r.corrections.pgs_unconverged, 0u);
+  EXPECT_FALSE(r.corrections.any());
+}
+
 // Kind B of issue 13, the last energy clamps: a coin within a few mrad of flat, tumbling at 30-80
 // rad/s about a nearly horizontal axis on one rim point, its lowest point jumping across the face
 // within microseconds, so the curvature impulse gained by its own work even after four halvings

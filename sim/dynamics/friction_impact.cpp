@@ -883,7 +883,9 @@ bool plastic_verifies(const Body& b, const Points& pts, const double pn[], const
     if (pt[i].norm() > limit * (1.0 + 1e-9)) return false;
     const Eigen::Vector2d slip(u.x(), u.y());
     const double sn = slip.norm();
-    if (sn > slip_tol && !(limit > 0.0 && (pt[i] / limit + slip / sn).norm() <= 1e-6)) return false;
+    // (A point without normal impulse has no friction, |P_t| <= 0 above, and may slip freely: a
+    // lifting point, as coulomb_verifies accepts R = 0.)
+    if (sn > slip_tol && limit > 0.0 && !((pt[i] / limit + slip / sn).norm() <= 1e-6)) return false;
   }
   return true;
 }
@@ -934,6 +936,33 @@ bool solve_stick_slide(const Body& b, const Points& pts, int i, int j, double sp
   return true;
 }
 
+// Two points, point i lifting and point j alone: the one-point plastic solve at j (its full
+// compliance), kept (true) only if Coulomb's law verifies at both points, i not approaching.
+bool solve_lift_one(const Body& b, const Points& pts, int i, double speed, double pn[], Eigen::Vector2d pt[]) {
+  const int j = 1 - i;
+  Points one;
+  one.n = 1;
+  one.r[0] = pts.r[j];
+  one.e[0] = pts.e[j];
+  one.mu[0] = pts.mu[j];
+  one.W0 = compliance(b, pts.r[j]);
+  one.W0_inverse = one.W0.inverse();
+  one.inv_wnn[0] = 1.0 / one.W0(2, 2);
+  const Vec3 v0 = b.s->velocity, w0 = b.s->omega;
+  double qn[1];
+  Eigen::Vector2d qt[1];
+  if (solve_plastic_single(b, one, qn, qt)) {
+    pn[i] = 0.0;
+    pt[i].setZero();
+    pn[j] = qn[0];
+    pt[j] = qt[0];
+    if (plastic_verifies(b, pts, pn, pt, speed)) return true;
+  }
+  b.s->velocity = v0;
+  b.s->omega = w0;
+  return false;
+}
+
 // The plastic solve of two points by their active sets, each case exact and taken only where
 // Coulomb's law verifies at both points (plastic_verifies): both stick (solve_sticking), one
 // sticks and the other slides (solve_stick_slide, both ways), both slide or one lifts
@@ -943,8 +972,11 @@ bool solve_stick_slide(const Body& b, const Points& pts, int i, int j, double sp
 // tips the coin about a diameter, moving both points sideways ~a/b = 18 times more than it
 // moves them vertically: the two normal rows are 0.975 correlated (Gauss-Seidel's error falls
 // ~0.5 % a sweep: ~4 000 sweeps), and at one point sticking and the other sliding the
-// Alart-Curnier residual's Newton step is no descent (a kink), so the finish stalls. The body
-// starts from the state before the solve (no impulse applied). False: the body untouched.
+// Alart-Curnier residual's Newton step is no descent (a kink), so the finish stalls. Last, one
+// point lifting and the other alone (solve_lift_one: a coin on its side, one rim's point
+// lifting while the other's slides, quarter `stepped` toss 79149, where solve_sliding's iterate
+// changed its active set after its first pass). The body starts from the state before the solve (no
+// impulse applied). False: the body untouched.
 bool solve_plastic_pair(const Body& b, const Mat3& Iw, const Points& pts, double speed, double lever, double pn[],
                         Eigen::Vector2d pt[]) {
   if (pts.n != 2) return false;
@@ -957,7 +989,8 @@ bool solve_plastic_pair(const Body& b, const Mat3& Iw, const Points& pts, double
   };
   if (verified(solve_sticking(b, Iw, pts, lever, pn, pt))) return true;
   if (solve_stick_slide(b, pts, 0, 1, speed, pn, pt) || solve_stick_slide(b, pts, 1, 0, speed, pn, pt)) return true;
-  return verified(solve_sliding(b, pts, speed, lever, pn, pt));
+  if (verified(solve_sliding(b, pts, speed, lever, pn, pt))) return true;
+  return solve_lift_one(b, pts, 0, speed, pn, pt) || solve_lift_one(b, pts, 1, speed, pn, pt);
 }
 
 // Projected Gauss-Seidel on the perfectly plastic frictional contact problem: at every point
