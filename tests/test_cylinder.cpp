@@ -815,6 +815,23 @@ TEST(CylinderStepped, CoinOnItsSideOnePointLiftingSolvesExactly) {
   EXPECT_FALSE(r.corrections.any());
 }
 
+// A coin landing flat on its tripod whose restitution friction Gauss-Seidel leaves unconverged and
+// the dual solve takes: two points sliding at ~1e-6 m/s, one sticking. The dual's motion was right
+// (its sticking multiplier inside the cone), but the polish's later rounds, recomputing the
+// sliding directions from slips that small, diverged (0.56 m/s along the friction), so nothing
+// verified. The earliest round that verifies is now kept. Quarter-table `stepped` toss 33234 (seed
+// 1), the one unconverged solve of its 10^5 tosses; it read pgs_unconverged 1 before.
+TEST(CylinderStepped, TripodDualKeepsTheRoundThatVerifies) {
+  const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter-table.toml",
+                                        {"sim.fidelity=\"stepped\""}));
+  TossProbe probe;
+  const TossResult r = toss(m, 1, 33234, &probe);
+  EXPECT_EQ(r.status, TossStatus::Settled);
+  EXPECT_EQ(r.corrections.pgs_unconverged, 0u);
+  EXPECT_FALSE(r.corrections.any());
+  EXPECT_GE(probe.dual_solves, 1u);  // the dual took it, and it is counted
+}
+
 // Kind B of issue 13, the last energy clamps: a coin within a few mrad of flat, tumbling at 30-80
 // rad/s about a nearly horizontal axis on one rim point, its lowest point jumping across the face
 // within microseconds, so the curvature impulse gained by its own work even after four halvings
