@@ -111,6 +111,11 @@ class FixedStepper {
   // face arrives within the step at one tripod point (the other may be rising).
   std::uint64_t face_jumped = 0;
   std::uint64_t face_jump_declined = 0;  // ... taken again but not kept (it clamped or lifted again)
+  // Curved dice: steps still capped after the halvings (or ending below the floor) whose impact
+  // struck the face's tripod while an arc of the rim between its points still came down, taken
+  // again with that arc struck too (step(), strike_rim); and those not kept.
+  std::uint64_t rim_struck = 0;
+  std::uint64_t rim_strike_declined = 0;
   // Curved dice: curvature impulses that held a start's depth below the floor (within the touch
   // tolerance) because closing it within the step would gain energy (curvature_support).
   std::uint64_t depth_held = 0;
@@ -159,6 +164,16 @@ class FixedStepper {
   // either: one tripod point joining suffices (both are added; step()'s kind B re-decision).
   void add_face_tripod(const RigidState& s, ContactSet& c, double window = 0.0, double depth = 0.0,
                        bool either = false) const;
+  // A curved die whose face's tripod (features 3r, 3r+1, 3r+2 of rim r all in c) is struck: the
+  // rim's most approaching point in the motion of s (the minimum over the circle of its normal
+  // velocity, in closed form), its lever arm and normal velocity; false if no such rim, or if
+  // that point neither lies within the strike tolerance of the floor nor reaches it within
+  // `window` at its speed.
+  bool rim_most_approaching(const RigidState& s, const ContactSet& c, double window, int& rim, Vec3& r,
+                            double& vz) const;
+  // The step's impact at c's points plus the rims' most approaching points, added one at a time
+  // while the impact leaves one approaching (step()'s rim strike).
+  ImpactResult strike_rim(RigidState& s0, const ContactSet& c);
   // try_step with the held corners asked to rise at `bias` (m/s, 0: none); false if that gains
   // energy (kinetic + m g (COM height + the deepest corner's depth)).
   bool try_step_with(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full, double bias);
@@ -287,6 +302,9 @@ class FixedStepper {
   // (a coin landing or lying nearly flat): its next call widens add_face_tripod by these, once.
   double land_window_ = 0.0, land_depth_ = 0.0;
   bool land_either_ = false;  // ... with one tripod point arriving enough (a kind B step)
+  // Set when step() takes a step again with its impact struck at the rim's most approaching
+  // points as well (strike_rim): read and cleared by its next call.
+  bool rim_strike_ = false;
   Vec3 free_end_row_ = Vec3::Zero();  // the full step's bottom row at its end, after the start's solve only
   double slap_u_[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
   bool impact_ = false;   // the current step starts with an impact (solved once for all its trials)

@@ -1574,6 +1574,41 @@ bool slips_past_cone(const Body& b, const Points& pts) {
 
 }  // namespace
 
+ImpactResult apply_friction_impact_at(const DieModel& m, RigidState& s, const ContactSet& c, const Vec3* r,
+                                      bool restitution) {
+  // set_up_geometry's set-up with the lever arms given (in one plane, at the lowest one's height,
+  // when they are within 1e-6 r of it, as there), then the same solve.
+  ContactGeometry geo;
+  geo.Iw = world_inertia(m, s.R);
+  const Body b0{m.mass, 1.0 / m.mass, s.R * m.principal_moments.cwiseInverse().asDiagonal() * s.R.transpose(), &s};
+  geo.inv_inertia = b0.inv_inertia;
+  Points& pts = geo.pts;
+  pts.n = c.n;
+  double plane_z = 0.0, top_z = 0.0;
+  for (int i = 0; i < c.n; ++i) {
+    pts.r[i] = r[i];
+    plane_z = i == 0 ? r[i].z() : std::min(plane_z, r[i].z());
+    top_z = i == 0 ? r[i].z() : std::max(top_z, r[i].z());
+  }
+  const bool one_plane = top_z - plane_z <= 1e-6 * m.bounding_radius;
+  for (int i = 0; i < c.n; ++i) {
+    const int v = c.vertex[i];
+    if (one_plane) pts.r[i].z() = plane_z;
+    pts.e[i] = m.vertex_restitution[v];
+    pts.mu[i] = m.vertex_friction[v];
+    const Mat3 W = compliance(b0, pts.r[i]);
+    if (i == 0) pts.W0 = W;
+    pts.inv_wnn[i] = 1.0 / W(2, 2);
+    pts.wtt[i] = W.topLeftCorner<2, 2>();
+    pts.wz[i] = W.col(2);
+  }
+  pts.sweep_terms = false;
+  if (c.n == 1) pts.W0_inverse = pts.W0.inverse();
+  else set_up_sweep_terms(geo);
+  geo.valid = true;
+  return apply_friction_impact(m, s, c, restitution, nullptr, nullptr, &geo);
+}
+
 ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,
                                    const ContactImpulses* warm, ContactImpulses* out, ContactGeometry* geometry,
                                    bool direct) {

@@ -125,6 +125,12 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
                                    const ContactImpulses* warm = nullptr, ContactImpulses* out = nullptr,
                                    ContactGeometry* geometry = nullptr, bool direct = true);
 
+// The same impact law at given contact points: r[i] the lever arm (world, from the COM) of point i,
+// c.vertex[i] the feature whose materials it has (a cylinder's rim points between its features:
+// FixedStepper's rim strike).
+ImpactResult apply_friction_impact_at(const DieModel& m, RigidState& s, const ContactSet& c, const Vec3* r,
+                                      bool restitution);
+
 // The one-corner plastic sliding impulse P = lambda (mu d, 1) (d a unit friction direction):
 // zero final normal velocity u + W P, final slip anti-parallel to d. W the point's compliance, u
 // its velocity before (u_z < 0), d0 the starting direction (opposite the slip before). The
