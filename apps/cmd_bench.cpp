@@ -123,6 +123,10 @@ nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
           // (the step restored and finished as before).
           {"face_jumped_per_toss", static_cast<double>(probe.face_jumped) / np},
           {"face_jump_declined_per_toss", static_cast<double>(probe.face_jump_declined) / np},
+          // Flat coins' tripod impacts taken again with the rim's approaching arc struck: kept,
+          // and declined.
+          {"rim_struck_per_toss", static_cast<double>(probe.rim_struck) / np},
+          {"rim_strike_declined_per_toss", static_cast<double>(probe.rim_strike_declined) / np},
           // Impacts whose restitution friction stalled in Gauss-Seidel and was solved by its dual.
           {"dual_solves", probe.dual_solves},
           // A flat die's held corners: the deepest one below the floor at a step's end (m), the
@@ -164,12 +168,13 @@ void print_text(const nlohmann::json& r) {
   if (r["fixed_steps_per_toss"].get<double>() > 0) {
     std::printf("  fixed steps/toss    %.1f\n", r["fixed_steps_per_toss"].get<double>());
     std::printf("    located %.3f  halved %.3f  capped curvature %.3f  slaps %.3f (no arrival %.4f, rim below %.4f)  landed "
-                "flat %.4f  depth held %.4f  face struck %.4f (declined %.4f) (per toss)\n",
+                "flat %.4f  depth held %.4f  face struck %.4f (declined %.4f)  rim struck %.4f (declined %.4f) (per toss)\n",
                 r["located_steps_per_toss"].get<double>(), r["halved_steps_per_toss"].get<double>(),
                 r["curvature_capped_per_toss"].get<double>(), r["slaps_per_toss"].get<double>(),
                 r["slap_no_arrival_per_toss"].get<double>(), r["slap_rim_below_per_toss"].get<double>(),
                 r["flat_landed_per_toss"].get<double>(), r["depth_held_per_toss"].get<double>(),
-                r["face_jumped_per_toss"].get<double>(), r["face_jump_declined_per_toss"].get<double>());
+                r["face_jumped_per_toss"].get<double>(), r["face_jump_declined_per_toss"].get<double>(),
+                r["rim_struck_per_toss"].get<double>(), r["rim_strike_declined_per_toss"].get<double>());
     if (r["max_held_sink_m"].get<double>() > 0)
       std::printf(
           "    held corners: deepest %.2g m  sank more than the bound %.3f  shortened %.3f  short %.3f  rise dropped "
@@ -274,7 +279,8 @@ void register_bench(CLI::App& app, int& exit_code) {
                 "search_steps_per_flight, fixed_steps_per_toss, located_steps_per_toss,\n"
                 "halved_steps_per_toss, curvature_capped_per_toss, slaps_per_toss, slap_no_arrival_per_toss,\n"
                 "slap_rim_below_per_toss, flat_landed_per_toss, depth_held_per_toss, face_jumped_per_toss,\n"
-                "face_jump_declined_per_toss, dual_solves, phases {name: {share, per_toss, us_each}},\n"
+                "face_jump_declined_per_toss, rim_struck_per_toss, rim_strike_declined_per_toss, dual_solves,\n"
+                "phases {name: {share, per_toss, us_each}},\n"
                 "other_share; with one fidelity its fields also at the top level");
   cmd->callback([args, &exit_code] { exit_code = run_bench(*args); });
 }

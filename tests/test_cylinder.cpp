@@ -878,6 +878,7 @@ TEST(CylinderStepped, FlatCoinsSpinOverStrikesTheRimBetweenTheTripod) {
     EXPECT_EQ(r.status, TossStatus::Settled) << i;
     EXPECT_FALSE(r.corrections.any()) << i;
     EXPECT_LE(probe.max_energy_gain, 1e-12) << i;
+    EXPECT_GE(probe.rim_struck, 1u) << i;  // by the rim strike, and counted
   }
 }
 

@@ -1493,6 +1493,8 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->flat_landed += st.flat_landed;
       stats->face_jumped += st.face_jumped;
       stats->face_jump_declined += st.face_jump_declined;
+      stats->rim_struck += st.rim_struck;
+      stats->rim_strike_declined += st.rim_strike_declined;
       stats->depth_held += st.depth_held;
       stats->dual_solves += st.dual_solves;
       stats->max_held_sink = std::max(stats->max_held_sink, st.max_held_sink);

@@ -338,6 +338,8 @@ struct StepperStats {
   std::uint64_t flat_landed = 0;      // steps taken again with a nearly flat face's tripod struck
   std::uint64_t face_jumped = 0;      // ... of them kind B steps (a near-flat coin's lowest point jumping)
   std::uint64_t face_jump_declined = 0;  // kind B steps taken again with the face struck, not kept
+  std::uint64_t rim_struck = 0;          // tripod impacts taken again with the rim's approaching arc struck
+  std::uint64_t rim_strike_declined = 0;  // ... taken again but not kept
   std::uint64_t depth_held = 0;       // curvature impulses that held a start's depth (closing it gained)
   std::uint64_t dual_solves = 0;      // impacts whose restitution friction the dual solve took
   // Flat dice (not corrections: a step's discretisation, reported): the deepest held corner below

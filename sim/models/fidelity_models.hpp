@@ -34,6 +34,8 @@ inline void add_stepper_stats(TossProbe& probe, const StepperStats& stats) {
   probe.flat_landed += stats.flat_landed;
   probe.face_jumped += stats.face_jumped;
   probe.face_jump_declined += stats.face_jump_declined;
+  probe.rim_struck += stats.rim_struck;
+  probe.rim_strike_declined += stats.rim_strike_declined;
   probe.depth_held += stats.depth_held;
   probe.dual_solves += stats.dual_solves;
 }

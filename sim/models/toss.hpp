@@ -79,6 +79,8 @@ struct TossProbe {
   std::uint64_t flat_landed = 0;       // curved dice: steps taken again with a nearly flat face's tripod struck
   std::uint64_t face_jumped = 0;       // ... of them because the lowest point jumped across the face (kind B)
   std::uint64_t face_jump_declined = 0;  // kind B steps taken again with the face struck but not kept
+  std::uint64_t rim_struck = 0;          // a flat coin's tripod impact taken again with its rim's approaching arc struck
+  std::uint64_t rim_strike_declined = 0;  // ... taken again but not kept
   std::uint64_t depth_held = 0;        // curved dice: curvature impulses that held a start's depth below the floor
   std::uint64_t dual_solves = 0;       // impacts whose restitution friction the dual solve took (Gauss-Seidel stalled)
   double max_held_sink = 0.0;          // flat dice: deepest held corner below the floor at any fixed step's end (m)
