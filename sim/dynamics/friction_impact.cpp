@@ -1491,8 +1491,10 @@ void set_up_sweep_terms(ContactGeometry& geo) {
   pts.sweep_terms = true;
 }
 
-// The part of a solve's set-up that depends only on the orientation R and the contact set.
-void set_up_geometry(const DieModel& m, const Body& b, const Mat3& R, const ContactSet& c, ContactGeometry& geo) {
+// The part of a solve's set-up that depends only on the orientation R and the contact set; the
+// points' lever arms r (from the COM, world), or (null) the contact set's features' own.
+void set_up_geometry(const DieModel& m, const Body& b, const Mat3& R, const ContactSet& c, ContactGeometry& geo,
+                     const Vec3* r = nullptr) {
   if (!geo.iw_given) geo.Iw = world_inertia(m, R);
   geo.inv_inertia = b.inv_inertia;
   Points& pts = geo.pts;
@@ -1508,7 +1510,7 @@ void set_up_geometry(const DieModel& m, const Body& b, const Mat3& R, const Cont
   // "touching") keeps its own geometry rather than a lever arm moved by a visible amount.
   double plane_z = 0.0, top_z = 0.0;
   for (int i = 0; i < c.n; ++i) {
-    pts.r[i] = contact_point(m, R, c.vertex[i]);
+    pts.r[i] = r ? r[i] : contact_point(m, R, c.vertex[i]);
     plane_z = i == 0 ? pts.r[i].z() : std::min(plane_z, pts.r[i].z());
     top_z = i == 0 ? pts.r[i].z() : std::max(top_z, pts.r[i].z());
   }
@@ -1576,36 +1578,10 @@ bool slips_past_cone(const Body& b, const Points& pts) {
 
 ImpactResult apply_friction_impact_at(const DieModel& m, RigidState& s, const ContactSet& c, const Vec3* r,
                                       bool restitution) {
-  // set_up_geometry's set-up with the lever arms given (in one plane, at the lowest one's height,
-  // when they are within 1e-6 r of it, as there), then the same solve.
-  ContactGeometry geo;
-  geo.Iw = world_inertia(m, s.R);
+  // (Body's own initialisation from the product, as apply_friction_impact's set-up has it.)
   const Body b0{m.mass, 1.0 / m.mass, s.R * m.principal_moments.cwiseInverse().asDiagonal() * s.R.transpose(), &s};
-  geo.inv_inertia = b0.inv_inertia;
-  Points& pts = geo.pts;
-  pts.n = c.n;
-  double plane_z = 0.0, top_z = 0.0;
-  for (int i = 0; i < c.n; ++i) {
-    pts.r[i] = r[i];
-    plane_z = i == 0 ? r[i].z() : std::min(plane_z, r[i].z());
-    top_z = i == 0 ? r[i].z() : std::max(top_z, r[i].z());
-  }
-  const bool one_plane = top_z - plane_z <= 1e-6 * m.bounding_radius;
-  for (int i = 0; i < c.n; ++i) {
-    const int v = c.vertex[i];
-    if (one_plane) pts.r[i].z() = plane_z;
-    pts.e[i] = m.vertex_restitution[v];
-    pts.mu[i] = m.vertex_friction[v];
-    const Mat3 W = compliance(b0, pts.r[i]);
-    if (i == 0) pts.W0 = W;
-    pts.inv_wnn[i] = 1.0 / W(2, 2);
-    pts.wtt[i] = W.topLeftCorner<2, 2>();
-    pts.wz[i] = W.col(2);
-  }
-  pts.sweep_terms = false;
-  if (c.n == 1) pts.W0_inverse = pts.W0.inverse();
-  else set_up_sweep_terms(geo);
-  geo.valid = true;
+  ContactGeometry geo;
+  set_up_geometry(m, b0, s.R, c, geo, r);
   return apply_friction_impact(m, s, c, restitution, nullptr, nullptr, &geo);
 }
 
