@@ -980,7 +980,7 @@ ImpactResult FixedStepper::strike_rim(RigidState& s0, const ContactSet& c) {
     Vec3 p;
     double vz = 0.0;
     if (k == 4 || cs.n >= kMaxContacts || !rim_most_approaching(s0, c, h_, rim, p, vz) ||
-        !(vz < -(v_impact_ + v_spin_ * s0.omega.squaredNorm())))
+        !(vz < -impact_speed(s0)))
       break;
     cs.vertex[cs.n] = 3 * rim;  // (its materials)
     r[cs.n++] = p;
@@ -1066,7 +1066,7 @@ int FixedStepper::step(RigidState& s, double ke) {
   if (c.n > 0) {
     double un = 0.0;
     for (int i = 0; i < c.n; ++i) un = std::min(un, corner_velocity(m, s0, c.vertex[i]).z());
-    impact_ = un < -(v_impact_ + v_spin_ * s0.omega.squaredNorm());
+    impact_ = un < -impact_speed(s0);
     if (impact_)
       imp_ = struck ? strike_rim(s0, c) : apply_friction_impact(m, s0, c, /*restitution=*/true, nullptr, nullptr, &geo_);
   }
@@ -1355,18 +1355,15 @@ int FixedStepper::step(RigidState& s, double ke) {
       if (wide.n == c.n && done->clamped) {
         add_face_tripod(s, wide, h_, std::max(0.0, below), /*either=*/true);
         if (wide.n > c.n) {
-          const auto count = [](const Corrections& k) {
-            return k.energy_clamps + k.overlap_fixes + k.pgs_unconverged + k.fallbacks;
-          };
           const FixedStepper kept = *this;  // (rare: a few in 10^4 tosses)
           const RigidState s_in = s;
-          const auto before = count(corrections);
+          const auto before = corrections.total();
           land_window_ = h_;
           land_depth_ = std::max(0.0, below);
           land_either_ = true;
           ++flat_landed;
           const int n = step(s);
-          if (count(corrections) - before < (below > touch_tol_ ? 2u : 1u)) {
+          if (corrections.total() - before < (below > touch_tol_ ? 2u : 1u)) {
             ++face_jumped;
             return n;
           }
@@ -1384,23 +1381,20 @@ int FixedStepper::step(RigidState& s, double ke) {
       // The face's tripod already struck by this step's impact, and an arc of the rim between its
       // points still coming down after it (restitution turned a fast spin over: strike_rim): the
       // step taken again with that arc struck too. Kept only if it counts fewer corrections than
-      // this step would; otherwise the state is restored and the step finished as it was.
+      // this step would (a step with none to replace is not taken again: it could not be kept);
+      // otherwise the state is restored and the step finished as it was.
+      const auto replaced = (impact_ ? imp_.corrections.total() : 0u) + done->sup.corrections.total() +
+                            (done->clamped ? 1u : 0u) + (below > touch_tol_ ? 1u : 0u);
       int rim;
       Vec3 p;
       double vz;
-      if (impact_ && rim_most_approaching(s0, c, h_, rim, p, vz) &&
-          vz < -(v_impact_ + v_spin_ * s0.omega.squaredNorm())) {
-        const auto count = [](const Corrections& k) {
-          return k.energy_clamps + k.overlap_fixes + k.pgs_unconverged + k.fallbacks;
-        };
-        const auto replaced = count(imp_.corrections) + count(done->sup.corrections) + (done->clamped ? 1u : 0u) +
-                              (below > touch_tol_ ? 1u : 0u);
+      if (replaced > 0 && impact_ && rim_most_approaching(s0, c, h_, rim, p, vz) && vz < -impact_speed(s0)) {
         const FixedStepper kept = *this;  // (rare: a few in 10^5 tosses)
         const RigidState s_in = s;
-        const auto before = count(corrections);
+        const auto before = corrections.total();
         rim_strike_ = true;
         const int n = step(s);
-        if (count(corrections) - before < replaced) {
+        if (corrections.total() - before < replaced) {
           ++rim_struck;
           return n;
         }

@@ -262,6 +262,8 @@ class FixedStepper {
   double start_shallow_ = 0.0;
   double a_down_ = 0.0;
   double v_spin_ = 0.0;  // Contact: 4 h r, the factor of |w|^2 in the threshold
+  // The normal speed above which a contact point's approach in state s is an impact.
+  double impact_speed(const RigidState& s) const { return v_impact_ + v_spin_ * s.omega.squaredNorm(); }
   double dt_ = 0.0;
   double end_ke_ = 0.0;  // step(): the kinetic energy of the state it returns
   Mat3 rot_start_ = Mat3::Identity();  // orientation at the start of the step being tried

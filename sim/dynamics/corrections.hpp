@@ -15,6 +15,7 @@ struct CorrectionCounts {
   Count fallbacks = 0;        // an exact solve failed (jam) or a frictionless rescue ran
 
   bool any() const { return energy_clamps || pgs_unconverged || overlap_fixes || fallbacks; }
+  Count total() const { return energy_clamps + pgs_unconverged + overlap_fixes + fallbacks; }
   template <class Other>
   void add(const CorrectionCounts<Other>& o) {
     energy_clamps += o.energy_clamps;

@@ -83,10 +83,6 @@ int rim_quasi_static_down(const DieModel& m, const Mat3& R, double tiebreak) {
   return -1;
 }
 
-int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak) {
-  return rim_rest_face_down(m, s, tiebreak, kinetic_energy(m, s));
-}
-
 int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, double ke) {
   const double mg = m.mass * m.gravity;
   // Above every barrier: only lying flat can decide, and only with a rim point on the floor.

@@ -27,9 +27,8 @@ void compute_rim_rest_geometry(DieModel& m);
 // rim balance decides). Returns the face down (0, 1, 2) or -1 if the step guard ran out.
 int rim_quasi_static_down(const DieModel& m, const Mat3& R, double tiebreak);
 
-// The face the die must come to rest on (energy below its basin's saddle), or -1.
-int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak);
-// The same given ke = kinetic_energy(m, s) (contact.hpp).
+// The face the die must come to rest on (energy below its basin's saddle), or -1; ke =
+// kinetic_energy(m, s) (contact.hpp). (rest_face_down dispatches here for a curved die.)
 int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, double ke);
 
 // Lowest contact-feature height relative to the COM (world z) over features not in c.
