@@ -24,22 +24,37 @@ inline Vec3 rim_down(const DieModel& m, const Mat3& R, const Vec3& K) {
   return u / n;
 }
 
-// Feature v's contact point relative to the COM (world), the rounding included.
-inline Vec3 rim_point(const DieModel& m, const Mat3& R, int v) {
-  const Vec3 K = R * m.rims.axis;
-  const Vec3 c = R * m.rims.centre + ((v < 3) ? m.rims.half : -m.rims.half) * K;
-  const Vec3 u = rim_down(m, R, K);
-  const int j = v % 3;
-  Vec3 p;
-  if (j == 0) {
-    p = c + m.rims.radius * u;
-  } else {
-    constexpr double kCos = -0.5, kSin = 0.86602540378443864676;
-    p = c + m.rims.radius * (kCos * u + (j == 1 ? kSin : -kSin) * K.cross(u));
+// The features at one orientation: what all six share (the world axis, the rim plane's centre,
+// the down direction and its perpendicular) computed once, for callers that visit several.
+// point(v) is rim_point(m, R, v), bit for bit.
+class RimFeatures {
+ public:
+  RimFeatures(const DieModel& m, const Mat3& R)
+      : m_(&m), K_(R * m.rims.axis), centre_(R * m.rims.centre), u_(rim_down(m, R, K_)), side_(K_.cross(u_)) {}
+
+  // Feature v's contact point relative to the COM (world), the rounding included.
+  Vec3 point(int v) const {
+    const Rims& rim = m_->rims;
+    const Vec3 c = centre_ + ((v < 3) ? rim.half : -rim.half) * K_;
+    const int j = v % 3;
+    Vec3 p;
+    if (j == 0) {
+      p = c + rim.radius * u_;
+    } else {
+      constexpr double kCos = -0.5, kSin = 0.86602540378443864676;
+      p = c + rim.radius * (kCos * u_ + (j == 1 ? kSin : -kSin) * side_);
+    }
+    p.z() -= m_->rounding;
+    return p;
   }
-  p.z() -= m.rounding;
-  return p;
-}
+
+ private:
+  const DieModel* m_;
+  Vec3 K_, centre_, u_, side_;
+};
+
+// Feature v's contact point relative to the COM (world), the rounding included.
+inline Vec3 rim_point(const DieModel& m, const Mat3& R, int v) { return RimFeatures(m, R).point(v); }
 
 // Height of the die's lowest point relative to its COM (world z), rounding included.
 inline double rim_lowest(const DieModel& m, const Mat3& R) {

@@ -408,15 +408,16 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
   ImpactResult res;
   int sweeps = 0;
   double gap_end = 0.0;  // the last solve's end gap
+  ContactGeometry geo_mid;  // every solve of the search is of cm at mid.R: one set-up
   const auto solve = [&](double b) {
     mid = base;
     mid.velocity.z() -= b;
-    res = apply_friction_impact(m, mid, cm, /*restitution=*/false);
+    res = apply_friction_impact(m, mid, cm, /*restitution=*/false, nullptr, nullptr, &geo_mid);
     mid.velocity.z() += b;
     sweeps += res.iterations;
     apply_rolling_resistance(m, mid, cm, res.normal_impulse);
     apply_pivoting_resistance(m, mid, cm, res.normal_impulse);
-    r1 = TorqueFreeRotation(m.principal_moments, mid.R, world_inertia(m, mid.R) * mid.omega);
+    r1 = TorqueFreeRotation(moments_, mid.R, world_inertia(m, mid.R) * mid.omega, /*bounds=*/false);
     const Vec3 z_row = r1.bottom_row(rest);
     double gap = std::numeric_limits<double>::infinity();
     for (int r = 0; r < 2; ++r)
@@ -519,10 +520,10 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
   // free motion, its end state and its lowest-point searches need no second piece.
   s = mid;
   Vec3 w_back;
-  TorqueFreeRotation(m.principal_moments, mid.R, -(world_inertia(m, mid.R) * mid.omega)).state(tau, s.R, w_back);
+  TorqueFreeRotation(moments_, mid.R, -(world_inertia(m, mid.R) * mid.omega), /*bounds=*/false).state(tau, s.R, w_back);
   s.omega = -w_back;
   s.position = mid.position - tau * mid.velocity;
-  rot.emplace(moments_, s.R, world_inertia(m, s.R) * s.omega);
+  rot.emplace(moments_, s.R, world_inertia(m, s.R) * s.omega, /*bounds=*/false);
 }
 
 void FixedStepper::start_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
@@ -548,12 +549,14 @@ void FixedStepper::start_support(RigidState& s, const ContactSet& c, double d, d
   const auto solve = [&](double b) {
     s = base;
     s.velocity.z() -= b;
-    a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next);
+    // (s.R is the step's start s0.R and c its set: the set-up geo_ the step's impact and trials share.)
+    a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
     s.velocity.z() += b;
     sweeps += a.sup.iterations;
     apply_rolling_resistance(m, s, c, a.sup.normal_impulse);
     apply_pivoting_resistance(m, s, c, a.sup.normal_impulse);
-    rot.emplace(moments_, s.R, world_inertia(m, s.R) * s.omega);
+    // (A curved die's rotations need no bounds: only model_root's search for a polyhedron reads them.)
+    rot.emplace(moments_, s.R, world_inertia(m, s.R) * s.omega, /*bounds=*/false);
     const Vec3 z_row = rot->bottom_row(d);
     double gap = std::numeric_limits<double>::infinity();
     for (int r = 0; r < 2; ++r)
@@ -909,9 +912,11 @@ void FixedStepper::add_face_tripod(const RigidState& s, ContactSet& c, double wi
   // within `depth`, or reaching the floor within `window` at its approach speed.
   const DieModel& m = *m_;
   const double face_tol = 1e-6 * m.bounding_radius;
+  const RimFeatures rims(m, s.R);
   const auto joins = [&](int f) {
-    const double z = corner_height(m, s, f);
-    return z <= face_tol || z <= depth || z <= -window * corner_velocity(m, s, f).z();
+    const Vec3 p = rims.point(f);
+    const double z = s.position.z() + p.z();  // corner_height, corner_velocity
+    return z <= face_tol || z <= depth || z <= -window * (s.velocity + s.omega.cross(p)).z();
   };
   const int n0 = c.n;
   for (int r = 0; r < 2; ++r) {
@@ -971,7 +976,8 @@ ImpactResult FixedStepper::strike_rim(RigidState& s0, const ContactSet& c) {
   const RigidState pre = s0;
   ContactSet cs = c;
   Vec3 r[kMaxContacts];
-  for (int i = 0; i < c.n; ++i) r[i] = contact_point(m, pre.R, c.vertex[i]);
+  const RimFeatures rims(m, pre.R);
+  for (int i = 0; i < c.n; ++i) r[i] = rims.point(c.vertex[i]);
   ImpactResult res;
   for (int k = 0;; ++k) {
     s0 = pre;

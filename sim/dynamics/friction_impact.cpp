@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <Eigen/QR>
 
@@ -1509,8 +1510,10 @@ void set_up_geometry(const DieModel& m, const Body& b, const Mat3& R, const Cont
   // spread wider (a cylinder sunk into the floor by the stepper's drift, both rims' lowest points
   // "touching") keeps its own geometry rather than a lever arm moved by a visible amount.
   double plane_z = 0.0, top_z = 0.0;
+  std::optional<RimFeatures> rims;  // a cylinder's points share their set-up
+  if (!r && m.curved()) rims.emplace(m, R);
   for (int i = 0; i < c.n; ++i) {
-    pts.r[i] = r ? r[i] : contact_point(m, R, c.vertex[i]);
+    pts.r[i] = r ? r[i] : rims ? rims->point(c.vertex[i]) : contact_point(m, R, c.vertex[i]);
     plane_z = i == 0 ? pts.r[i].z() : std::min(plane_z, pts.r[i].z());
     top_z = i == 0 ? pts.r[i].z() : std::max(top_z, pts.r[i].z());
   }
@@ -1538,8 +1541,10 @@ ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol) 
   ContactSet c;
   double z[kMaxContacts];
   const int nv = m.vertex_count();
+  std::optional<RimFeatures> rims;  // a cylinder's six features share their set-up
+  if (m.curved()) rims.emplace(m, s.R);
   for (int i = 0; i < nv; ++i) {
-    const double zi = corner_height(m, s, i);
+    const double zi = rims ? s.position.z() + rims->point(i).z() : corner_height(m, s, i);
     if (zi > tol) continue;
     if (c.n < kMaxContacts) {
       z[c.n] = zi;

@@ -111,8 +111,9 @@ int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, 
   if (!(m.face_hold[di] > 0.0 &&
         m.max_friction * m.face_height[di] + spin_max2 * m.face_gyro[di] / mg < 0.999 * m.face_hold[di]))
     return -1;
+  const RimFeatures rims(m, s.R);
   for (int j = 0; j < 3; ++j) {
-    const Vec3 r = rim_point(m, s.R, 3 * down + j);
+    const Vec3 r = rims.point(3 * down + j);
     if (s.position.z() + r.z() - std::min(low, 0.0) > flat_tol) return -1;
     if (std::abs((s.velocity + s.omega.cross(r)).z()) > v_tol) return -1;
   }
@@ -121,13 +122,14 @@ int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, 
 
 double rim_lowest_excluding(const DieModel& m, const Mat3& R, const ContactSet& c) {
   double low = kInf;
+  const RimFeatures rims(m, R);
   int j = 0;  // c.vertex is ascending
   for (int i = 0; i < kRimFeatures; ++i) {
     if (j < c.n && c.vertex[j] == i) {
       ++j;
       continue;
     }
-    low = std::min(low, rim_point(m, R, i).z());
+    low = std::min(low, rims.point(i).z());
   }
   return low;
 }
