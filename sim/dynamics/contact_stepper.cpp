@@ -408,7 +408,11 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
   ImpactResult res;
   int sweeps = 0;
   double gap_end = 0.0;  // the last solve's end gap
-  ContactGeometry geo_mid;  // every solve of the search is of cm at mid.R: one set-up
+  // Every solve of the search is of cm at mid.R (= base.R): one set-up, one world inertia.
+  ContactGeometry geo_mid;
+  geo_mid.Iw = world_inertia(m, base.R);
+  geo_mid.iw_given = true;
+  const Mat3& Iw_mid = geo_mid.Iw;
   const auto solve = [&](double b) {
     mid = base;
     mid.velocity.z() -= b;
@@ -417,7 +421,7 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
     sweeps += res.iterations;
     apply_rolling_resistance(m, mid, cm, res.normal_impulse);
     apply_pivoting_resistance(m, mid, cm, res.normal_impulse);
-    r1 = TorqueFreeRotation(moments_, mid.R, world_inertia(m, mid.R) * mid.omega, /*bounds=*/false);
+    r1 = TorqueFreeRotation(moments_, mid.R, Iw_mid * mid.omega, /*bounds=*/false);
     const Vec3 z_row = r1.bottom_row(rest);
     double gap = std::numeric_limits<double>::infinity();
     for (int r = 0; r < 2; ++r)
@@ -520,7 +524,7 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
   // free motion, its end state and its lowest-point searches need no second piece.
   s = mid;
   Vec3 w_back;
-  TorqueFreeRotation(moments_, mid.R, -(world_inertia(m, mid.R) * mid.omega), /*bounds=*/false).state(tau, s.R, w_back);
+  TorqueFreeRotation(moments_, mid.R, -(Iw_mid * mid.omega), /*bounds=*/false).state(tau, s.R, w_back);
   s.omega = -w_back;
   s.position = mid.position - tau * mid.velocity;
   rot.emplace(moments_, s.R, world_inertia(m, s.R) * s.omega, /*bounds=*/false);
@@ -556,7 +560,7 @@ void FixedStepper::start_support(RigidState& s, const ContactSet& c, double d, d
     apply_rolling_resistance(m, s, c, a.sup.normal_impulse);
     apply_pivoting_resistance(m, s, c, a.sup.normal_impulse);
     // (A curved die's rotations need no bounds: only model_root's search for a polyhedron reads them.)
-    rot.emplace(moments_, s.R, world_inertia(m, s.R) * s.omega, /*bounds=*/false);
+    rot.emplace(moments_, s.R, Iw_start_ * s.omega, /*bounds=*/false);  // (s.R is s0.R)
     const Vec3 z_row = rot->bottom_row(d);
     double gap = std::numeric_limits<double>::infinity();
     for (int r = 0; r < 2; ++r)
