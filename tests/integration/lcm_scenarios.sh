@@ -266,7 +266,10 @@ case "$scenario" in
     # The aggregator itself dies (kill -9) mid-run and is resumed from its checkpoint: the same run
     # id, the same two workers (never restarted), counts identical to toss; a recorder across the
     # restart gives a log that replays to the same counts and says how many tosses were computed twice.
-    n=1000000
+    # 4*10^6 tosses: the aggregator checkpoints at most once a second, so the first checkpoint
+    # holding tosses comes ~1 s in; 10^6 paper tosses on two workers took ~1.2 s, and under load the
+    # kill once landed after the run had finished (the workers gone, the resume waited for them).
+    n=4000000
     reference
     ckpt=$work/run.ckpt
     "$bin" record -o "$work/run.lcmlog" --until-done --timeout 150 2> "$work/rec.err" & rec=$!; pids+=($rec)
