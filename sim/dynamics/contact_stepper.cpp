@@ -404,7 +404,6 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
     if (rim_in[r]) cm.vertex[cm.n++] = 3 * r;
   const double rest = d - tau;
   const RigidState base = mid;
-  TorqueFreeRotation r1;
   ImpactResult res;
   int sweeps = 0;
   double gap_end = 0.0;  // the last solve's end gap
@@ -421,8 +420,7 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
     sweeps += res.iterations;
     apply_rolling_resistance(m, mid, cm, res.normal_impulse);
     apply_pivoting_resistance(m, mid, cm, res.normal_impulse);
-    r1 = TorqueFreeRotation(moments_, mid.R, Iw_mid * mid.omega, /*bounds=*/false);
-    const Vec3 z_row = r1.bottom_row(rest);
+    const Vec3 z_row = TorqueFreeRotation::bottom_row_at(moments_, mid.R, Iw_mid * mid.omega, rest);
     double gap = std::numeric_limits<double>::infinity();
     for (int r = 0; r < 2; ++r)
       if (rim_in[r]) gap = std::min(gap, mid.position.z() + mid.velocity.z() * rest + support_low(z_row, r));
@@ -559,17 +557,22 @@ void FixedStepper::start_support(RigidState& s, const ContactSet& c, double d, d
     sweeps += a.sup.iterations;
     apply_rolling_resistance(m, s, c, a.sup.normal_impulse);
     apply_pivoting_resistance(m, s, c, a.sup.normal_impulse);
-    // (A curved die's rotations need no bounds: only model_root's search for a polyhedron reads them.)
-    rot.emplace(moments_, s.R, Iw_start_ * s.omega, /*bounds=*/false);  // (s.R is s0.R)
-    const Vec3 z_row = rot->bottom_row(d);
+    // The end's bottom row only (s.R is s0.R); the rotation itself is built once, for the solve
+    // that stands (done).
+    const Vec3 z_row = TorqueFreeRotation::bottom_row_at(moments_, s.R, Iw_start_ * s.omega, d);
     double gap = std::numeric_limits<double>::infinity();
     for (int r = 0; r < 2; ++r)
       if (rim_in[r]) gap = std::min(gap, s.position.z() + s.velocity.z() * d + rim_low_z(m, z_row, r));
     return gap;
   };
+  const auto done = [&] {
+    a.sup.iterations = sweeps;
+    // (A curved die's rotations need no bounds: only model_root's search for a polyhedron reads them.)
+    rot.emplace(moments_, s.R, Iw_start_ * s.omega, /*bounds=*/false);
+  };
   const double g0 = solve(0.0);
   if (!(d > 0.0) || g0 <= touch_tol_ || !(a.sup.normal_impulse > 0.0)) {
-    a.sup.iterations = sweeps;
+    done();
     return;
   }
   double hi = 0.0, g_hi = g0, lo = -g0 / d, g_lo = solve(lo);
@@ -610,7 +613,7 @@ void FixedStepper::start_support(RigidState& s, const ContactSet& c, double d, d
     ++start_capped;
     ++a.sup.corrections.energy_clamps;
   }
-  a.sup.iterations = sweeps;
+  done();
 }
 
 namespace {

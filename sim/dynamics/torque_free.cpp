@@ -438,6 +438,35 @@ Vec3 TorqueFreeRotation::bottom_row(double t) const {
   return r;
 }
 
+Vec3 TorqueFreeRotation::bottom_row_at(const Moments& moments, const Mat3& R0, const Vec3& L_world, double t) {
+  if (L_world.squaredNorm() == 0.0) return R0.row(2).transpose();  // Still
+  if (moments.general) return TorqueFreeRotation(moments, R0, L_world, /*bounds=*/false).bottom_row(t);
+  // The constructor's and init_symmetric's expressions, row 2 of along, across and cross only.
+  const Vec3 L_body = R0.transpose() * L_world;
+  const double L_norm = L_world.norm();
+  const Vec3 L_hat = L_world / L_norm;
+  const double precession_rate = L_norm * moments.inv_I_perp;
+  const double spin_rate = (moments.inv_I_axis - moments.inv_I_perp) * L_body[moments.axis];
+  const Eigen::RowVector3d LR = L_hat.transpose() * R0;  // along = L_hat LR
+  SinCos a, b;
+  sincos2(precession_rate * t, spin_rate * t, a, b);
+  Vec3 r;
+  for (int j = 0; j < 3; ++j) {
+    const double along = L_hat.z() * LR(j);
+    const double across = R0(2, j) - along;
+    const double cross = L_hat.cross(R0.col(j)).z();
+    r(j) = along + a.cos * across + a.sin * cross;
+  }
+  if (spin_rate != 0.0) {
+    const int p = moments.p, q = moments.q;
+    const double cb = b.cos, sb = b.sin;
+    const double rp = r(p), rq = r(q);
+    r(p) = cb * rp + sb * rq;
+    r(q) = cb * rq - sb * rp;
+  }
+  return r;
+}
+
 Vec3 TorqueFreeRotation::bottom_row(double t, Vec3& rate) const {
   if (kind_ == Kind::Still) {
     rate.setZero();

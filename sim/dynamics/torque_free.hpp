@@ -38,6 +38,11 @@ class TorqueFreeRotation {
   // The orientation's bottom row (world z of each body axis) at time t: all a corner's height needs.
   // Equal to orientation(t).row(2) up to rounding.
   Vec3 bottom_row(double t) const;
+  // The bottom row at t of the rotation TorqueFreeRotation(moments, R0, L_world) would give, bit for
+  // bit, without setting up the rest of it: a symmetric top's set-up reduced to the row (the same
+  // expressions, entry by entry). For a search that asks one row of many rotations (the stepper's
+  // support solves).
+  static Vec3 bottom_row_at(const Moments& moments, const Mat3& R0, const Vec3& L_world, double t);
   // The same and its time derivative, R(t)^T (e_z x omega(t)) (the model search's Newton slope).
   Vec3 bottom_row(double t, Vec3& rate) const;
   // Orientation and world angular velocity at time t.
