@@ -129,6 +129,10 @@ nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
           {"rim_strike_declined_per_toss", static_cast<double>(probe.rim_strike_declined) / np},
           // Impacts whose restitution friction stalled in Gauss-Seidel and was solved by its dual.
           {"dual_solves", probe.dual_solves},
+          // Solves whose first method failed and an exact second one took (the same law, verified):
+          // a one-point slide's reference solve after its Newton, an edge's or a pair's exact
+          // solve after the sweeps.
+          {"exact_fallbacks", probe.exact_fallbacks},
           // A flat die's held corners: the deepest one below the floor at a step's end (m), the
           // steps in which one sank more than the bound, and (`impulse`) the steps tried again
           // shorter for the bound and those whose full length was below the contact step.
@@ -165,6 +169,9 @@ void print_text(const nlohmann::json& r) {
   if (r["dual_solves"].get<std::uint64_t>() > 0)
     std::printf("  dual friction solves %llu (restitution friction that stalled in Gauss-Seidel; verified)\n",
                 static_cast<unsigned long long>(r["dual_solves"].get<std::uint64_t>()));
+  if (r["exact_fallbacks"].get<std::uint64_t>() > 0)
+    std::printf("  exact fallbacks     %llu (solves whose first method failed, taken by an exact second; verified)\n",
+                static_cast<unsigned long long>(r["exact_fallbacks"].get<std::uint64_t>()));
   if (r["fixed_steps_per_toss"].get<double>() > 0) {
     std::printf("  fixed steps/toss    %.1f\n", r["fixed_steps_per_toss"].get<double>());
     std::printf("    located %.3f  halved %.3f  capped curvature %.3f  slaps %.3f (no arrival %.4f, rim below %.4f)  landed "
@@ -280,6 +287,7 @@ void register_bench(CLI::App& app, int& exit_code) {
                 "halved_steps_per_toss, curvature_capped_per_toss, slaps_per_toss, slap_no_arrival_per_toss,\n"
                 "slap_rim_below_per_toss, flat_landed_per_toss, depth_held_per_toss, face_jumped_per_toss,\n"
                 "face_jump_declined_per_toss, rim_struck_per_toss, rim_strike_declined_per_toss, dual_solves,\n"
+                "exact_fallbacks,\n"
                 "phases {name: {share, per_toss, us_each}},\n"
                 "other_share; with one fidelity its fields also at the top level");
   cmd->callback([args, &exit_code] { exit_code = run_bench(*args); });

@@ -809,10 +809,12 @@ TEST(CylinderStepped, NearFlatCurvatureImpulseIsHalvedNotClamped) {
 TEST(CylinderStepped, CoinOnItsSideOnePointLiftingSolvesExactly) {
   const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter.toml",
                                         {"sim.fidelity=\"stepped\""}));
-  const TossResult r = toss(m, 1, 79149);
+  TossProbe probe;
+  const TossResult r = toss(m, 1, 79149, &probe);
   EXPECT_EQ(r.status, TossStatus::Settled);
   EXPECT_EQ(r.corrections.pgs_unconverged, 0u);
   EXPECT_FALSE(r.corrections.any());
+  EXPECT_GE(probe.exact_fallbacks, 1u);  // the pair's exact solve after the sweeps, counted
 }
 
 // A coin landing flat on its tripod whose restitution friction Gauss-Seidel leaves unconverged and

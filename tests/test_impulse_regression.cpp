@@ -116,6 +116,22 @@ TEST(ImpulseStepper, LocatedStepsMostlyLandOnTheirFirstTrial) {
   }
 }
 
+// A one-point slide whose Newton fails, taken by the reference solve (the same law, verified):
+// counted as an exact fallback, never silent. Die 1 `impulse` toss 84 (seed 1) has one; 3000 tosses
+// have 5 in their first 800 (a search of the probe's counter, 2026-11-28).
+TEST(ImpulseStepper, ExactFallbacksAreCounted) {
+  const DieModel m = compile(dicesim::testing::with_fidelity(
+      load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/paper/die1.toml"), Fidelity::Impulse));
+  TossProbe probe;
+  const TossResult r = toss(m, 1, 84, &probe);
+  EXPECT_EQ(r.status, TossStatus::Settled);
+  EXPECT_FALSE(r.corrections.any());  // not a correction: the law is solved exactly either way
+  EXPECT_EQ(probe.exact_fallbacks, 1u);
+  TossProbe quiet;  // and a toss without one reads 0
+  toss(m, 1, 83, &quiet);
+  EXPECT_EQ(quiet.exact_fallbacks, 0u);
+}
+
 TEST(SteppedRegression, CountsArePinned) {
   const Golden golden[] = {
       {"scenes/paper/die1.toml", {17, 12, 21, 18, 2, 30}, 2017, {0, 0, 0, 0}},

@@ -515,6 +515,7 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
   }
   ++curvature_impulses;
   a.sup.corrections.add(res.corrections);
+  a.sup.exact_fallbacks += res.exact_fallbacks;
   a.sup.iterations += sweeps;
   a.sup.normal_impulse += res.normal_impulse;
   // As a state at the step's start whose free motion for d is the motion after the impulse: the
@@ -1424,6 +1425,7 @@ int FixedStepper::step(RigidState& s, double ke) {
     corrections.add(a.imp.corrections);
     sweeps += static_cast<std::uint64_t>(a.imp.iterations);
     dual_solves += static_cast<std::uint64_t>(a.imp.dual_solves);
+    exact_fallbacks += static_cast<std::uint64_t>(a.imp.exact_fallbacks);
     max_energy_gain = std::max(max_energy_gain, relative_gain(a.imp.energy_before, a.imp.energy_after));
   }
   // An accepted step whose curvature impulse was capped (to gain no energy) is a clamp, counted
@@ -1431,6 +1433,7 @@ int FixedStepper::step(RigidState& s, double ke) {
   if (a.clamped) ++corrections.energy_clamps;
   if (c.n > 0) {
     corrections.add(a.sup.corrections);
+    exact_fallbacks += static_cast<std::uint64_t>(a.sup.exact_fallbacks);
     sweeps += static_cast<std::uint64_t>(a.sup.iterations);
     max_energy_gain = std::max(max_energy_gain, relative_gain(a.sup.energy_before, a.sup.energy_after));
   }
@@ -1504,6 +1507,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->rim_strike_declined += st.rim_strike_declined;
       stats->depth_held += st.depth_held;
       stats->dual_solves += st.dual_solves;
+      stats->exact_fallbacks += st.exact_fallbacks;
       stats->max_held_sink = std::max(stats->max_held_sink, st.max_held_sink);
       stats->held_sinks += st.held_sinks;
       stats->sink_shortened += st.sink_shortened;

@@ -121,6 +121,9 @@ class FixedStepper {
   std::uint64_t depth_held = 0;
   // Impacts whose restitution friction was taken by the dual solve (Gauss-Seidel stalled).
   std::uint64_t dual_solves = 0;
+  // Solves of accepted steps (impacts and supports) that an exact second method took
+  // (ImpactResult::exact_fallbacks).
+  std::uint64_t exact_fallbacks = 0;
   double max_held_sink = 0.0;            // flat dice: deepest held corner below the floor at a step's end (m)
   std::uint64_t held_sinks = 0;          // flat dice: steps in which a held corner sank more than max_sink (or touch_tol)
   std::uint64_t sink_shortened = 0;      // flat dice, max_sink: steps tried again shorter (deeper than max_sink)
@@ -344,6 +347,7 @@ struct StepperStats {
   std::uint64_t rim_strike_declined = 0;  // ... taken again but not kept
   std::uint64_t depth_held = 0;       // curvature impulses that held a start's depth (closing it gained)
   std::uint64_t dual_solves = 0;      // impacts whose restitution friction the dual solve took
+  std::uint64_t exact_fallbacks = 0;  // accepted steps' solves an exact second method took (ImpactResult)
   // Flat dice (not corrections: a step's discretisation, reported): the deepest held corner below
   // the floor at a step's end, the steps that ended deeper than the max_sink bound, and with
   // max_sink the steps tried again shorter and those whose full length was below h.

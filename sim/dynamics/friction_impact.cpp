@@ -35,6 +35,10 @@ struct Body {
   double mass, inv_mass;
   Mat3 inv_inertia;  // world
   RigidState* s;
+  int* exact_fallbacks = nullptr;  // ImpactResult::exact_fallbacks of the solve, counted where taken
+  void count_exact_fallback() const {
+    if (exact_fallbacks) ++*exact_fallbacks;
+  }
   void apply(const Vec3& r, const Vec3& P) const {
     s->velocity += P * inv_mass;
     s->omega += inv_inertia * r.cross(P);
@@ -394,8 +398,10 @@ bool solve_plastic_single(const Body& b, const Points& pts, double pn[], Eigen::
   if (d.norm() <= 1e-300) return false;
   d.normalize();
   Vec3 P;
-  if (!one_corner_sliding_newton(pts.W0, u, mu, d, P) && !one_corner_sliding_reference(pts.W0, u, mu, d, P))
-    return false;
+  if (!one_corner_sliding_newton(pts.W0, u, mu, d, P)) {
+    if (!one_corner_sliding_reference(pts.W0, u, mu, d, P)) return false;
+    b.count_exact_fallback();
+  }
   b.apply(r, P);
   pn[0] = P.z();
   pt[0] = Eigen::Vector2d(P.x(), P.y());
@@ -913,8 +919,11 @@ bool solve_stick_slide(const Body& b, const Points& pts, int i, int j, double sp
   if (!(d.norm() > 1e-9 * speed)) return false;
   d.normalize();
   Vec3 Pj;
-  if (!one_corner_sliding_newton(S, c, pts.mu[j], d, Pj) && !one_corner_sliding_reference(S, c, pts.mu[j], d, Pj))
-    return false;
+  bool by_reference = false;
+  if (!one_corner_sliding_newton(S, c, pts.mu[j], d, Pj)) {
+    if (!one_corner_sliding_reference(S, c, pts.mu[j], d, Pj)) return false;
+    by_reference = true;
+  }
   const Vec3 Pi = -(Wii_inv * (ui + Wij * Pj));
   const Vec3 v0 = b.s->velocity, w0 = b.s->omega;
   b.apply(pts.r[i], Pi);
@@ -934,6 +943,7 @@ bool solve_stick_slide(const Body& b, const Points& pts, int i, int j, double sp
     pn[k] = qn[k];
     pt[k] = qt[k];
   }
+  if (by_reference) b.count_exact_fallback();  // (only a solve that stands)
   return true;
 }
 
@@ -1455,6 +1465,7 @@ SweepResult solve_friction(const Body& b, const Points& pts, const double radius
     if (solve_friction_edge(b, edge, edge_radius, edge_pt, lever, speed, steps)) {
       for (int i = 0; i < pts.n; ++i) pt[i].setZero();
       for (int k = 0; k < 2; ++k) pt[carry[k]] = edge_pt[k];
+      b.count_exact_fallback();
       return {kMaxSweeps + nr.iterations + steps, true};
     }
     b.s->velocity = v_gs;  // back to the Gauss-Seidel iterate, counted by the caller
@@ -1609,7 +1620,7 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
     set_up_geometry(m, b0, s.R, c, geo);
   }
   const Mat3& Iw = geo.Iw;
-  Body b{m.mass, 1.0 / m.mass, geo.inv_inertia, &s};
+  Body b{m.mass, 1.0 / m.mass, geo.inv_inertia, &s, &res.exact_fallbacks};
   const Points& pts = geo.pts;
   double u0n[kMaxContacts];
   for (int i = 0; i < c.n; ++i) u0n[i] = b.point_velocity(pts.r[i]).z();
@@ -1687,6 +1698,7 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
           pt[i] = qt[i];
         }
         sr.converged = true;
+        ++res.exact_fallbacks;
       } else {
         s.velocity = gs.velocity;
         s.omega = gs.omega;

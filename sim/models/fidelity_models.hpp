@@ -38,6 +38,7 @@ inline void add_stepper_stats(TossProbe& probe, const StepperStats& stats) {
   probe.rim_strike_declined += stats.rim_strike_declined;
   probe.depth_held += stats.depth_held;
   probe.dual_solves += stats.dual_solves;
+  probe.exact_fallbacks += stats.exact_fallbacks;
 }
 
 // `static`: the initial orientation, then the quasi-static roll (sim/rest.hpp). No dynamics.

@@ -90,6 +90,7 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
     if (probe) {
       probe->pgs_sweeps += static_cast<std::uint64_t>(imp.iterations);
       probe->dual_solves += static_cast<std::uint64_t>(imp.dual_solves);
+      probe->exact_fallbacks += static_cast<std::uint64_t>(imp.exact_fallbacks);
       if (imp.energy_before > 0.0)
         probe->max_energy_gain =
             std::max(probe->max_energy_gain, (imp.energy_after - imp.energy_before) / imp.energy_before);

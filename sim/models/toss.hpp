@@ -83,6 +83,7 @@ struct TossProbe {
   std::uint64_t rim_strike_declined = 0;  // ... taken again but not kept
   std::uint64_t depth_held = 0;        // curved dice: curvature impulses that held a start's depth below the floor
   std::uint64_t dual_solves = 0;       // impacts whose restitution friction the dual solve took (Gauss-Seidel stalled)
+  std::uint64_t exact_fallbacks = 0;   // solves an exact second method took (ImpactResult::exact_fallbacks)
   double max_held_sink = 0.0;          // flat dice: deepest held corner below the floor at any fixed step's end (m)
   std::uint64_t held_sinks = 0;        // flat dice: fixed steps whose held corners sank more than the bound
   std::uint64_t sink_shortened = 0;    // flat dice, `impulse`: fixed steps tried again shorter for that bound
