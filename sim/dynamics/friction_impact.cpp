@@ -1642,8 +1642,9 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
   if (c.n == 1) {
     solved = solve_plastic_single(b, pts, pn, pt);
     // A jam (no sliding direction found that stops the point): the general solve below takes it
-    // (Gauss-Seidel, finished by Newton), counted only if that does not converge.
+    // (Gauss-Seidel, finished by Newton), an exact fallback if it converges, else unconverged.
   }
+  const bool jammed = c.n == 1 && !solved;
   if (!solved && direct && c.n >= 2 && (!m.curved() || slips_past_cone(b, pts))) {
     // The two common cases directly: every point sliding (or lifting), then every point sticking;
     // else the sweeps. Each answer is kept only where Coulomb's law verifies at every point, so
@@ -1706,6 +1707,7 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
     }
     res.iterations += sr.sweeps;
     if (!sr.converged) ++res.corrections.pgs_unconverged;
+    else if (jammed) ++res.exact_fallbacks;
   }
   Vec3 total[kMaxContacts];
   for (int i = 0; i < c.n; ++i) total[i] = Vec3(pt[i].x(), pt[i].y(), pn[i]);

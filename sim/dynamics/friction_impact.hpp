@@ -106,10 +106,11 @@ struct ImpactResult {
   double energy_after = 0.0;
   int iterations = 0;           // Gauss-Seidel sweeps (both phases; 0 for an exact one-point solve)
   int dual_solves = 0;          // restitution friction taken by the dual solve after Gauss-Seidel stalled (verified, exact)
-  // Solves whose first method failed and an exact second one took (verified, the same law: not a
-  // correction, reported): a one-point slide's Newton failed and its reference solve
-  // (one_corner_sliding_reference) took it; the sweeps stalled and an edge's or a pair's exact
-  // solve took it (the dual's are dual_solves).
+  // Solves whose first method failed and a second one took (the same law: not a correction,
+  // reported): a one-point slide's Newton failed and its reference solve
+  // (one_corner_sliding_reference) took it; a one-point jam (no sliding direction) taken by the
+  // sweeps, converged; the sweeps stalled and an edge's or a pair's exact solve took it (the
+  // dual's are dual_solves).
   int exact_fallbacks = 0;
   Corrections corrections;      // energy clamp, unconverged solve, fallback of this impact
 };
