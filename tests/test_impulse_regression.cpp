@@ -66,6 +66,7 @@
 
 #include "fidelity_test_util.hpp"
 #include "sim/dynamics/contact_stepper.hpp"
+#include "sim/models/fidelity_models.hpp"
 #include "sim/models/toss.hpp"
 
 namespace {
@@ -130,6 +131,41 @@ TEST(ImpulseStepper, ExactFallbacksAreCounted) {
   TossProbe quiet;  // and a toss without one reads 0
   toss(m, 1, 83, &quiet);
   EXPECT_EQ(quiet.exact_fallbacks, 0u);
+  // A located step whose search runs out of trials (a nearly tangential touch: the longest trial
+  // above the floor is taken, the corner touches in the next step) is counted too: toss 98.
+  TossProbe capped;
+  toss(m, 1, 98, &capped);
+  EXPECT_EQ(capped.located_capped, 1u);
+  EXPECT_EQ(quiet.located_capped, 0u);
+}
+
+// A die at rest balanced exactly on an edge (its COM straight above the edge's midpoint) cannot
+// decide by itself: the stepper breaks the balance with a tiny spin the toss's tiebreak orients
+// (1e-4 sqrt(g / r), far below any throw's). That adds energy, so it is counted and reported
+// (nudges), never silent. The fair d6 on the edge between corners 0 and its first neighbour.
+TEST(ImpulseStepper, ExactBalancesAreNudgedAndCounted) {
+  const DieModel m = compile(dicesim::testing::with_fidelity(
+      load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/dice/d6.toml"), Fidelity::Impulse));
+  const Vec3 v0 = m.vertices[0], v1 = m.vertices[static_cast<std::size_t>(m.neighbours(0)[0])];
+  const Vec3 e = (v1 - v0).normalized();
+  const Vec3 mid = 0.5 * (v0 + v1);
+  const Vec3 up = (-mid - (-mid).dot(e) * e).normalized();  // body direction to become world +z
+  RigidState s;
+  s.R.row(0) = e.transpose();
+  s.R.row(1) = up.cross(e).transpose();
+  s.R.row(2) = up.transpose();
+  ASSERT_NEAR(s.R.determinant(), 1.0, 1e-12);
+  s.position = Vec3(0.0, 0.0, m.rounding - s.R.row(2).dot(v0));
+  s.velocity.setZero();
+  s.omega.setZero();
+  TossProbe probe;
+  const TossResult r = run_impulse(m, s, 0.3, &probe);
+  EXPECT_EQ(r.status, TossStatus::Settled);
+  EXPECT_GE(probe.nudges, 1u);
+  EXPECT_LE(probe.nudges, 4u);  // at most four per stepper run
+  TossProbe thrown;  // a thrown die needs none
+  toss(m, 1, 0, &thrown);
+  EXPECT_EQ(thrown.nudges, 0u);
 }
 
 TEST(SteppedRegression, CountsArePinned) {

@@ -1265,7 +1265,8 @@ int FixedStepper::step(RigidState& s, double ke) {
     }
     if (!done) {
       // Not within the tolerance in kMaxTrials trials (the touch is nearly tangential): the longest
-      // trial that ends above the floor; the corner touches in the next step.
+      // trial that ends above the floor; the corner touches in the next step. Counted.
+      ++located_capped;
       if (have_lo) {
         done = lo;
         dt = d_lo;
@@ -1493,6 +1494,8 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->steps += steps;
       stats->located += st.located;
       stats->located_trials += st.located_trials;
+      stats->located_capped += st.located_capped;
+      stats->nudges += static_cast<std::uint64_t>(out.nudges);
       stats->max_energy_gain = std::max(stats->max_energy_gain, st.max_energy_gain);
       stats->max_penetration = std::max(stats->max_penetration, st.max_penetration);
       stats->halved += st.halved;

@@ -90,6 +90,9 @@ class FixedStepper {
   std::uint64_t sweeps = 0;       // Gauss-Seidel sweeps of every solve so far
   std::uint64_t located = 0;      // steps shortened to a new contact's instant
   std::uint64_t located_trials = 0;  // whole trial steps of those shortened steps (the full one not counted)
+  // ... of them not within the touch tolerance in kMaxTrials trials (a nearly tangential touch):
+  // the longest trial that ends above the floor taken, the corner touching in the next step.
+  std::uint64_t located_capped = 0;
   double max_energy_gain = 0.0;   // largest relative gain of one impact's kinetic or one step's mechanical energy
   double max_penetration = 0.0;   // curved dice: deepest lowest point below the floor at a step's end (m)
   std::uint64_t curvature_impulses = 0;  // curved dice: mid-step curvature impulses (rim_support)
@@ -331,6 +334,8 @@ struct StepperStats {
   std::uint64_t steps = 0;
   std::uint64_t located = 0;  // steps shortened to a new contact's instant
   std::uint64_t located_trials = 0;  // their trial steps of shortened length
+  std::uint64_t located_capped = 0;  // ... not within the tolerance in kMaxTrials trials (FixedStepper)
+  std::uint64_t nudges = 0;          // exact balances at rest broken by the toss's tiebreak (a tiny spin)
   double max_energy_gain = 0.0;
   double max_penetration = 0.0;  // curved dice: deepest lowest point below the floor at a step's end (m)
   // Curved dice, adaptive steps (not corrections): steps halved because a capped curvature impulse

@@ -19,6 +19,8 @@ inline void add_stepper_stats(TossProbe& probe, const StepperStats& stats) {
   probe.steps += stats.steps;
   probe.located_steps += stats.located;
   probe.located_trials += stats.located_trials;
+  probe.located_capped += stats.located_capped;
+  probe.nudges += stats.nudges;
   probe.max_energy_gain = std::max(probe.max_energy_gain, stats.max_energy_gain);
   probe.max_penetration = std::max(probe.max_penetration, stats.max_penetration);
   probe.halved += stats.halved;

@@ -69,6 +69,8 @@ struct TossProbe {
   std::uint64_t steps = 0;
   std::uint64_t located_steps = 0;  // fixed steps shortened to the instant a new corner touches
   std::uint64_t located_trials = 0;  // their trial steps (each a whole step of shortened length)
+  std::uint64_t located_capped = 0;  // ... not within the touch tolerance in the trials allowed (the longest above taken)
+  std::uint64_t nudges = 0;          // exact balances at rest broken by the toss's tiebreak (a spin of 1e-4 sqrt(g/r))
   double max_energy_gain = 0.0;
   double max_penetration = 0.0;  // curved dice: deepest rim below the floor at any fixed step's end (m)
   std::uint64_t halved = 0;            // curved dice: fixed steps halved (a capped curvature impulse)
