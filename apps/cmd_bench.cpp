@@ -113,6 +113,8 @@ nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
           {"nudges_per_toss", static_cast<double>(probe.nudges) / np},
           {"halved_steps_per_toss", static_cast<double>(probe.halved) / np},
           {"curvature_capped_per_toss", static_cast<double>(probe.curvature_capped) / np},
+          // Curved dice: support searches out of iterations (the bracket's end above the floor taken).
+          {"support_search_capped_per_toss", static_cast<double>(probe.support_search_capped) / np},
           {"slaps_per_toss", static_cast<double>(probe.slaps) / np},
           // The slap's re-decisions: the plain step when its far half does not arrive, the plain
           // search again when a located slap leaves the rest of the rim below the floor.
@@ -178,12 +180,12 @@ void print_text(const nlohmann::json& r) {
                 static_cast<unsigned long long>(r["exact_fallbacks"].get<std::uint64_t>()));
   if (r["fixed_steps_per_toss"].get<double>() > 0) {
     std::printf("  fixed steps/toss    %.1f\n", r["fixed_steps_per_toss"].get<double>());
-    std::printf("    located %.3f (out of trials %.4f)  halved %.3f  capped curvature %.3f  slaps %.3f (no arrival %.4f, rim "
-                "below %.4f)  landed flat %.4f  depth held %.4f  face struck %.4f (declined %.4f)  rim struck %.4f (declined "
-                "%.4f)  balances nudged %.4f (per toss)\n",
+    std::printf("    located %.3f (out of trials %.4f)  halved %.3f  capped curvature %.3f  support searches out of "
+                "iterations %.4f  slaps %.3f (no arrival %.4f, rim below %.4f)  landed flat %.4f  depth held %.4f  face "
+                "struck %.4f (declined %.4f)  rim struck %.4f (declined %.4f)  balances nudged %.4f (per toss)\n",
                 r["located_steps_per_toss"].get<double>(), r["located_capped_per_toss"].get<double>(),
-                r["halved_steps_per_toss"].get<double>(),
-                r["curvature_capped_per_toss"].get<double>(), r["slaps_per_toss"].get<double>(),
+                r["halved_steps_per_toss"].get<double>(), r["curvature_capped_per_toss"].get<double>(),
+                r["support_search_capped_per_toss"].get<double>(), r["slaps_per_toss"].get<double>(),
                 r["slap_no_arrival_per_toss"].get<double>(), r["slap_rim_below_per_toss"].get<double>(),
                 r["flat_landed_per_toss"].get<double>(), r["depth_held_per_toss"].get<double>(),
                 r["face_jumped_per_toss"].get<double>(), r["face_jump_declined_per_toss"].get<double>(),
@@ -292,7 +294,8 @@ void register_bench(CLI::App& app, int& exit_code) {
                 "tosses_per_s (all threads), scaling_efficiency, identical_counts, impacts_per_toss,\n"
                 "search_steps_per_flight, fixed_steps_per_toss, located_steps_per_toss, located_capped_per_toss,\n"
                 "nudges_per_toss, "
-                "halved_steps_per_toss, curvature_capped_per_toss, slaps_per_toss, slap_no_arrival_per_toss,\n"
+                "halved_steps_per_toss, curvature_capped_per_toss, support_search_capped_per_toss,\n"
+                "slaps_per_toss, slap_no_arrival_per_toss,\n"
                 "slap_rim_below_per_toss, flat_landed_per_toss, depth_held_per_toss, face_jumped_per_toss,\n"
                 "face_jump_declined_per_toss, rim_struck_per_toss, rim_strike_declined_per_toss, dual_solves,\n"
                 "exact_fallbacks,\n"

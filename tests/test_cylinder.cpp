@@ -806,6 +806,19 @@ TEST(CylinderStepped, NearFlatCurvatureImpulseIsHalvedNotClamped) {
 // case with the other lifting was rejected because the lifting point slips (plastic_verifies
 // asked friction of a point with no normal impulse). Quarter `stepped` toss 79149 (seed 1), the
 // one unconverged solve of its 10^5 tosses; it read pgs_unconverged 1 before.
+// A support search out of iterations takes its bracket's end above the floor (the rim ends a
+// little above it): not a correction of the law, but a guard, counted (support_search_capped).
+// Three-sided coin `impulse` toss 503 (seed 1) has one; toss 502 none.
+TEST(CylinderImpulse, SupportSearchesOutOfIterationsAreCounted) {
+  const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/three-sided-coin.toml"));
+  TossProbe capped, plain;
+  const TossResult r = toss(m, 1, 503, &capped);
+  toss(m, 1, 502, &plain);
+  EXPECT_EQ(r.status, TossStatus::Settled);
+  EXPECT_EQ(capped.support_search_capped, 1u);
+  EXPECT_EQ(plain.support_search_capped, 0u);
+}
+
 TEST(CylinderStepped, CoinOnItsSideOnePointLiftingSolvesExactly) {
   const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter.toml",
                                         {"sim.fidelity=\"stepped\""}));

@@ -464,7 +464,8 @@ void FixedStepper::curvature_support(RigidState& s, const ContactSet& c, double 
       x = solve(b) - target;
       br.update(b, x, /*lo_side=*/x < 0.0);
     }
-    if (!accepted(x) && b != br.hi) {
+    if (!accepted(x) && b != br.hi) {  // out of iterations: the bracket's end above the floor, counted
+      ++support_search_capped;
       b = br.hi;
       x = solve(b) - target;
     }
@@ -591,7 +592,8 @@ void FixedStepper::start_support(RigidState& s, const ContactSet& c, double d, d
       g = solve(b);
       br.update(b, g, /*lo_side=*/g < 0.0);
     }
-    if (g < -touch_tol_) {  // not converged: the bracket's end above the floor
+    if (g < -touch_tol_) {  // not converged: the bracket's end above the floor, counted
+      ++support_search_capped;
       b = br.hi;
       solve(b);
     }
@@ -1500,6 +1502,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->max_penetration = std::max(stats->max_penetration, st.max_penetration);
       stats->halved += st.halved;
       stats->curvature_capped += st.curvature_capped;
+      stats->support_search_capped += st.support_search_capped;
       stats->slaps += st.slaps;
       stats->slap_no_arrival += st.slap_no_arrival;
       stats->slap_rim_below += st.slap_rim_below;

@@ -98,6 +98,9 @@ class FixedStepper {
   std::uint64_t curvature_impulses = 0;  // curved dice: mid-step curvature impulses (rim_support)
   std::uint64_t curvature_capped = 0;    // ... of them capped to gain no energy
   std::uint64_t start_capped = 0;        // curved dice: start solves capped to gain no energy (energy_clamps)
+  // Curved dice: support searches (start_support's reduced push, curvature_support's impulse) out
+  // of iterations, their bracket's end above the floor taken (the rim ends a little above it); any trial.
+  std::uint64_t support_search_capped = 0;
   std::uint64_t halved = 0;              // curved dice: steps halved because the cap left them sinking (or unreflected)
   std::uint64_t slaps = 0;               // curved dice: steps shortened to a slapping face's arrival
   // Curved dice: the slap's two re-decisions (step()): the plain step taken because a slap's far
@@ -342,6 +345,7 @@ struct StepperStats {
   // left the rims sinking, curvature impulses capped (in any trial), steps shortened to a slap.
   std::uint64_t halved = 0;
   std::uint64_t curvature_capped = 0;
+  std::uint64_t support_search_capped = 0;  // support searches out of iterations, the end above the floor taken
   std::uint64_t slaps = 0;
   std::uint64_t slap_no_arrival = 0;  // a slap's far half did not arrive: the plain step taken
   std::uint64_t slap_rim_below = 0;   // a located slap left the rest of the rim below: the plain search again

@@ -30,6 +30,7 @@ inline void add_stepper_stats(TossProbe& probe, const StepperStats& stats) {
   probe.short_steps += stats.short_steps;
   probe.rise_dropped += stats.rise_dropped;
   probe.curvature_capped += stats.curvature_capped;
+  probe.support_search_capped += stats.support_search_capped;
   probe.slaps += stats.slaps;
   probe.slap_no_arrival += stats.slap_no_arrival;
   probe.slap_rim_below += stats.slap_rim_below;

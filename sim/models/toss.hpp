@@ -75,6 +75,7 @@ struct TossProbe {
   double max_penetration = 0.0;  // curved dice: deepest rim below the floor at any fixed step's end (m)
   std::uint64_t halved = 0;            // curved dice: fixed steps halved (a capped curvature impulse)
   std::uint64_t curvature_capped = 0;  // curved dice: curvature impulses capped to gain no energy (any trial)
+  std::uint64_t support_search_capped = 0;  // curved dice: support searches out of iterations (end above the floor taken; any trial)
   std::uint64_t slaps = 0;             // curved dice: fixed steps shortened to a slapping face's arrival
   std::uint64_t slap_no_arrival = 0;   // curved dice: slaps whose far half did not arrive (the plain step taken)
   std::uint64_t slap_rim_below = 0;    // curved dice: located slaps that left the rim below (the plain search again)
