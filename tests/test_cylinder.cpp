@@ -66,6 +66,19 @@ void expect_repaired(const DieModel& m, std::initializer_list<std::uint64_t> tos
   }
 }
 
+// A `stepped` coin toss whose one solve once stalled unconverged: now settled, without any
+// correction, and the second method that took the solve counted in `used`.
+void expect_solved_by(const char* scene, std::uint64_t index, std::uint64_t TossProbe::*used) {
+  const DieModel m =
+      compile(load_scene(std::string(DICESIM_SOURCE_DIR) + scene, {"sim.fidelity=\"stepped\""}));
+  TossProbe probe;
+  const TossResult r = toss(m, 1, index, &probe);
+  EXPECT_EQ(r.status, TossStatus::Settled) << scene << " " << index;
+  EXPECT_EQ(r.corrections.pgs_unconverged, 0u) << scene << " " << index;
+  EXPECT_FALSE(r.corrections.any()) << scene << " " << index;
+  EXPECT_GE(probe.*used, 1u) << scene << " " << index;
+}
+
 void expect_rel(double got, double want, double tol, const char* what) {
   EXPECT_NEAR(got, want, tol * std::abs(want)) << what;
 }
@@ -820,14 +833,8 @@ TEST(CylinderImpulse, SupportSearchesOutOfIterationsAreCounted) {
 }
 
 TEST(CylinderStepped, CoinOnItsSideOnePointLiftingSolvesExactly) {
-  const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter.toml",
-                                        {"sim.fidelity=\"stepped\""}));
-  TossProbe probe;
-  const TossResult r = toss(m, 1, 79149, &probe);
-  EXPECT_EQ(r.status, TossStatus::Settled);
-  EXPECT_EQ(r.corrections.pgs_unconverged, 0u);
-  EXPECT_FALSE(r.corrections.any());
-  EXPECT_GE(probe.exact_fallbacks, 1u);  // the pair's exact solve after the sweeps, counted
+  // (The pair's exact solve after the sweeps, counted.)
+  expect_solved_by("/scenes/coins/quarter.toml", 79149, &TossProbe::exact_fallbacks);
 }
 
 // A coin landing flat on its tripod whose restitution friction Gauss-Seidel leaves unconverged and
@@ -837,14 +844,7 @@ TEST(CylinderStepped, CoinOnItsSideOnePointLiftingSolvesExactly) {
 // verified. The earliest round that verifies is now kept. Quarter-table `stepped` toss 33234 (seed
 // 1), the one unconverged solve of its 10^5 tosses; it read pgs_unconverged 1 before.
 TEST(CylinderStepped, TripodDualKeepsTheRoundThatVerifies) {
-  const DieModel m = compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter-table.toml",
-                                        {"sim.fidelity=\"stepped\""}));
-  TossProbe probe;
-  const TossResult r = toss(m, 1, 33234, &probe);
-  EXPECT_EQ(r.status, TossStatus::Settled);
-  EXPECT_EQ(r.corrections.pgs_unconverged, 0u);
-  EXPECT_FALSE(r.corrections.any());
-  EXPECT_GE(probe.dual_solves, 1u);  // the dual took it, and it is counted
+  expect_solved_by("/scenes/coins/quarter-table.toml", 33234, &TossProbe::dual_solves);  // the dual took it, counted
 }
 
 // Kind B of issue 13, the last energy clamps: a coin within a few mrad of flat, tumbling at 30-80

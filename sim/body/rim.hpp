@@ -48,6 +48,11 @@ class RimFeatures {
     return p;
   }
 
+  const Vec3& axis() const { return K_; }        // the world axis K
+  const Vec3& centre() const { return centre_; }  // the rims' mid-plane centre, from the COM (world)
+  const Vec3& down() const { return u_; }         // unit, in the rim plane, most nearly down (rim_down)
+  const Vec3& side() const { return side_; }      // K x down
+
  private:
   const DieModel* m_;
   Vec3 K_, centre_, u_, side_;

@@ -952,19 +952,19 @@ bool FixedStepper::rim_most_approaching(const RigidState& s, const ContactSet& c
   // A + a (alpha cos t + beta sin t) in the rim's basis (u, K x u): its minimum lies at
   // -(alpha, beta) / |(alpha, beta)|.
   const DieModel& m = *m_;
-  const Vec3 K = s.R * m.rims.axis;
-  const Vec3 u = rim_down(m, s.R, K), w2 = K.cross(u);
+  const RimFeatures rims(m, s.R);
+  const Vec3 &K = rims.axis(), &u = rims.down(), &w2 = rims.side();
+  // (alpha, beta): the same for both rims (their points differ by a multiple of K).
+  const double alpha = s.omega.cross(u).z(), beta = s.omega.cross(w2).z();
+  const double n = std::sqrt(alpha * alpha + beta * beta);
+  if (!(n > 0.0)) return false;
   const double face_tol = 1e-6 * m.bounding_radius;
   bool found = false;
   for (int q = 0; q < 2; ++q) {
     int in = 0;
     for (int i = 0; i < c.n; ++i) in += c.vertex[i] / 3 == q ? 1 : 0;
     if (in < 3) continue;
-    const double alpha = s.omega.cross(u).z(), beta = s.omega.cross(w2).z();
-    const double n = std::sqrt(alpha * alpha + beta * beta);
-    if (!(n > 0.0)) continue;
-    Vec3 p = s.R * m.rims.centre + (q == 0 ? m.rims.half : -m.rims.half) * K -
-             (m.rims.radius / n) * (alpha * u + beta * w2);
+    Vec3 p = rims.centre() + (q == 0 ? m.rims.half : -m.rims.half) * K - (m.rims.radius / n) * (alpha * u + beta * w2);
     p.z() -= m.rounding;
     const double v = (s.velocity + s.omega.cross(p)).z();
     const double z = s.position.z() + p.z();
