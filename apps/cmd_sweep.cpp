@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
+#include "apps/gnuplot.hpp"
 #include "apps/progress.hpp"
 #include "apps/report.hpp"
 #include "apps/sweep_workers.hpp"
@@ -83,39 +84,14 @@ std::string fmt(const char* f, double v) {
   return buf;
 }
 
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw std::runtime_error("cannot write '" + path + "'");
-  out << text;
-  if (!out) throw std::runtime_error("cannot write '" + path + "'");
-}
-
-std::string gnuplot_quote(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '\n') {
-      out += "\\n";
-      continue;
-    }
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
 bool has_categories(const SweepSpec& spec) { return spec.categorical; }
 
 // P(face) against x, one colour per outcome (label order; ten colours, then again with another
 // point type), the 95% Wilson band shaded, the seed's values (if any) as open circles of the same colour.
 void write_plot(const std::string& path, const SweepSpec& spec, const SweepResult& res,
                 const std::vector<ReferenceRow>& seed_rows) {
-  const std::string ext = fs::path(path).extension().string();
   std::ostringstream gp;
-  if (ext == ".svg")
-    gp << "set terminal svg size 840,520 dynamic font 'sans,11' background rgb 'white'\n";
-  else
-    gp << "set terminal pngcairo size 840,520 font 'sans,10' background rgb 'white'\n";
-  gp << "set output " << gnuplot_quote(path) << "\n";
+  gp << gnuplot_terminal(path);
   std::string title = spec.title;
   if (!spec.reproduces.empty()) title += " (seed: " + spec.reproduces + ")";
   gp << "set title " << gnuplot_quote(title + "\n" + std::to_string(spec.tosses) + " tosses per point, seed " +
@@ -171,25 +147,7 @@ void write_plot(const std::string& path, const SweepSpec& spec, const SweepResul
     gp << "NaN with points pt 6 ps 1.1 lc rgb 'black' title 'seed'\n";
   }
 
-  const fs::path script = fs::temp_directory_path() / ("dicesim-plot-" + std::to_string(::getpid()) + ".gp");
-  const fs::path err = fs::temp_directory_path() / ("dicesim-plot-" + std::to_string(::getpid()) + ".err");
-  write_text(script.string(), gp.str());
-  const std::string cmd = "gnuplot " + script.string() + " 2>" + err.string();
-  const int rc = std::system(cmd.c_str());
-  std::string err_text;
-  {
-    std::ifstream e(err);
-    std::stringstream ss;
-    ss << e.rdbuf();
-    err_text = ss.str();
-  }
-  fs::remove(script);
-  fs::remove(err);
-  if (rc != 0) {
-    if (WIFEXITED(rc) && WEXITSTATUS(rc) == 127)
-      throw std::runtime_error("--plot needs gnuplot: install the Debian package gnuplot-nox (scripts/setup does)");
-    throw std::runtime_error("gnuplot failed writing '" + path + "': " + err_text);
-  }
+  run_gnuplot(gp.str(), path);
 }
 
 std::string csv_text(const SweepResult& res) {

@@ -1,6 +1,8 @@
 #include "sim/study/compare.hpp"
 
 #include <algorithm>
+#include <fstream>
+#include <sstream>
 #include <cmath>
 #include <iterator>
 #include <string>
@@ -9,6 +11,9 @@
 #include <stdexcept>
 
 #include <boost/math/distributions/chi_squared.hpp>
+#include <nlohmann/json.hpp>
+
+#include "sim/scene/scene_error.hpp"
 
 namespace dicesim {
 
@@ -99,5 +104,74 @@ Comparison compare_counts(const FaceCounts& a, const FaceCounts& b) {
   c.chi2 = chi2_homogeneity(ca, cb, &c.min_expected);
   return c;
 }
+
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  const auto e = s.find_last_not_of(" \t\r\n");
+  return b == std::string::npos ? "" : s.substr(b, e - b + 1);
+}
+
+}  // namespace
+
+FaceCounts read_face_counts(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path, "", "", "cannot open file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  FaceCounts fc;
+  const std::string t = trim(text);
+  if (!t.empty() && t[0] == '{') {
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(t);
+    } catch (const std::exception& e) {
+      throw SceneError(path, "", "", std::string("not valid JSON: ") + e.what());
+    }
+    if (!j.contains("faces") || !j["faces"].is_array())
+      throw SceneError(path, "faces", "", "missing: expected the output of `dicesim toss --json`");
+    for (const auto& f : j["faces"]) {
+      if (!f.contains("face") || !f["face"].is_number_integer() || !f.contains("count") || !f["count"].is_number_unsigned())
+        throw SceneError(path, "faces[]", f.dump(), "each face needs an integer 'face' and a count >= 0");
+      fc.labels.push_back(f["face"].get<int>());
+      fc.counts.push_back(f["count"].get<std::uint64_t>());
+    }
+  } else {
+    std::istringstream lines(text);
+    std::string line;
+    int line_no = 0;
+    bool first = true;
+    while (std::getline(lines, line)) {
+      ++line_no;
+      const std::string l = trim(line);
+      if (l.empty() || l[0] == '#') continue;
+      const auto comma = l.find(',');
+      if (comma == std::string::npos || l.find(',', comma + 1) != std::string::npos)
+        throw SceneError(path, "line " + std::to_string(line_no), "'" + l + "'", "expected two columns: face,count");
+      const std::string a = trim(l.substr(0, comma)), b = trim(l.substr(comma + 1));
+      char* ea = nullptr;
+      char* eb = nullptr;
+      const long face = std::strtol(a.c_str(), &ea, 10);
+      const double count = std::strtod(b.c_str(), &eb);
+      const bool numeric = !a.empty() && !b.empty() && *ea == '\0' && *eb == '\0';
+      if (!numeric && first) {  // the header
+        first = false;
+        continue;
+      }
+      first = false;
+      if (!numeric || face < 0 || face > 999 || !(count >= 0) || count != std::floor(count) || count > 1e15)
+        throw SceneError(path, "line " + std::to_string(line_no), "'" + l + "'",
+                         "expected face (a label, an integer in [0, 999]) and count (an integer >= 0)");
+      fc.labels.push_back(static_cast<int>(face));
+      fc.counts.push_back(static_cast<std::uint64_t>(count));
+    }
+  }
+  if (fc.labels.size() < 2) throw SceneError(path, "", "", "needs the counts of at least 2 faces");
+  if (fc.total() == 0) throw SceneError(path, "", "", "all counts are 0");
+  return fc;
+}
+
 
 }  // namespace dicesim

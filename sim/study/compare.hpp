@@ -44,6 +44,11 @@ ChiSquare chi2_homogeneity(const std::vector<std::uint64_t>& a, const std::vecto
 Interval difference_interval(std::uint64_t x_a, std::uint64_t n_a, std::uint64_t x_b, std::uint64_t n_b,
                              double z = kZ95);
 
+// Observed (or simulated) counts from a file: the output of `dicesim toss --json` (faces[].face,
+// faces[].count), or a CSV face,count with an optional header and '#' comments. Throws SceneError
+// naming the file, the line and what is allowed; at least 2 faces, not all 0.
+FaceCounts read_face_counts(const std::string& path);
+
 // Compares two results. The label sets must be equal (throws std::invalid_argument otherwise).
 Comparison compare_counts(const FaceCounts& a, const FaceCounts& b);
 

@@ -1,0 +1,611 @@
+#include "sim/study/fit.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+#include <Eigen/Dense>
+#include <boost/math/distributions/chi_squared.hpp>
+
+#include "sim/models/compile.hpp"
+#include "sim/models/toss.hpp"
+#include "sim/scene/scene.hpp"
+#include "sim/scene/scene_error.hpp"
+#include "sim/study/monte_carlo.hpp"
+#include "sim/study/sweep.hpp"
+
+namespace dicesim {
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+constexpr double kChi2Level95 = 3.841458820694124;  // chi2_1 quantile 0.95: the profile's cut
+
+// Monomials of total degree <= degree in d <= 3 variables.
+struct Basis {
+  int d = 1;
+  std::vector<std::array<int, 3>> exps;
+  Basis(int dims, int degree) : d(dims) {
+    for (int total = 0; total <= degree; ++total)
+      for (int a = total; a >= 0; --a)
+        for (int b = (d > 1 ? total - a : 0); b >= 0; --b) {
+          const int c = total - a - b;
+          if ((d < 3 && c != 0) || (d < 2 && b != 0)) continue;
+          exps.push_back({a, b, c});
+        }
+  }
+  int size() const { return static_cast<int>(exps.size()); }
+  VectorXd eval(const std::array<double, 3>& u) const {
+    VectorXd phi(size());
+    for (int t = 0; t < size(); ++t) {
+      double v = 1.0;
+      for (int i = 0; i < d; ++i)
+        for (int e = 0; e < exps[static_cast<std::size_t>(t)][static_cast<std::size_t>(i)]; ++e) v *= u[static_cast<std::size_t>(i)];
+      phi[t] = v;
+    }
+    return phi;
+  }
+};
+
+struct Box {
+  std::vector<double> lo, hi;
+  std::array<double, 3> scaled(const VectorXd& theta) const {
+    std::array<double, 3> u{0.0, 0.0, 0.0};
+    for (std::size_t i = 0; i < lo.size(); ++i)
+      u[i] = (2.0 * theta[static_cast<Eigen::Index>(i)] - lo[i] - hi[i]) / (hi[i] - lo[i]);
+    return u;
+  }
+};
+
+// Counts of one design point and data set, per batch: outcomes in label order, and settled.
+struct PointCounts {
+  std::vector<std::vector<std::uint64_t>> faces;  // [batch][outcome]
+  std::vector<std::uint64_t> settled;             // [batch]
+};
+
+// log p~ per data set: a polynomial per outcome, fitted in the box's scaled coordinates.
+struct Surrogate {
+  Basis basis;
+  Box box;
+  std::vector<MatrixXd> coef;  // per data set: basis x outcomes
+
+  VectorXd log_p(std::size_t s, const VectorXd& theta) const {
+    const VectorXd f = coef[s].transpose() * basis.eval(box.scaled(theta));
+    const double top = f.maxCoeff();
+    const double lse = top + std::log((f.array() - top).exp().sum());
+    return f.array() - lse;
+  }
+};
+
+// Weighted least squares of log((c + 1/2) / (n + K/2)) with weights n p / (1 - p), the inverse of
+// the estimate's binomial variance (the 1/2s keep outcomes never seen finite).
+MatrixXd fit_log_p(const Basis& basis, const std::vector<VectorXd>& phi, const std::vector<std::vector<double>>& c,
+                   const std::vector<double>& n) {
+  const std::size_t J = phi.size(), K = c.front().size();
+  MatrixXd coef(basis.size(), static_cast<Eigen::Index>(K));
+  MatrixXd A(static_cast<Eigen::Index>(J), basis.size());
+  VectorXd y(static_cast<Eigen::Index>(J));
+  for (std::size_t k = 0; k < K; ++k) {
+    for (std::size_t j = 0; j < J; ++j) {
+      const double p = (c[j][k] + 0.5) / (n[j] + 0.5 * static_cast<double>(K));
+      const double w = std::sqrt(std::max(n[j], 1.0) * p / std::max(1.0 - p, 1e-12));
+      A.row(static_cast<Eigen::Index>(j)) = w * phi[j].transpose();
+      y[static_cast<Eigen::Index>(j)] = w * std::log(p);
+    }
+    coef.col(static_cast<Eigen::Index>(k)) = A.colPivHouseholderQr().solve(y);
+  }
+  return coef;
+}
+
+using Objective = std::function<double(const VectorXd&)>;
+
+// Compass search inside the box from x with initial steps `step` (per dimension): try +-step along
+// each axis, move on improvement, halve when nothing improves. Smooth, low-dimensional objective.
+VectorXd pattern_search(const Objective& f, const Box& box, VectorXd x, VectorXd step, double* fx_out = nullptr) {
+  double fx = f(x);
+  const Eigen::Index d = x.size();
+  for (int iter = 0; iter < 20000; ++iter) {
+    bool moved = false;
+    for (Eigen::Index i = 0; i < d; ++i)
+      for (const double sign : {1.0, -1.0}) {
+        VectorXd y = x;
+        y[i] = std::clamp(x[i] + sign * step[i], box.lo[static_cast<std::size_t>(i)], box.hi[static_cast<std::size_t>(i)]);
+        if (y[i] == x[i]) continue;
+        const double fy = f(y);
+        if (fy > fx) {
+          x = y;
+          fx = fy;
+          moved = true;
+        }
+      }
+    if (!moved) {
+      step *= 0.5;
+      bool small = true;
+      for (Eigen::Index i = 0; i < d; ++i)
+        small = small && step[i] < 1e-11 * (box.hi[static_cast<std::size_t>(i)] - box.lo[static_cast<std::size_t>(i)]);
+      if (small) break;
+    }
+  }
+  if (fx_out) *fx_out = fx;
+  return x;
+}
+
+// The maximum over the box: a grid (fine in one dimension, coarse in three), then the compass search.
+VectorXd maximize(const Objective& f, const Box& box, double* fx_out = nullptr) {
+  const int d = static_cast<int>(box.lo.size());
+  const int g = d == 1 ? 401 : d == 2 ? 61 : 21;
+  VectorXd best(d), x(d);
+  double fbest = -std::numeric_limits<double>::infinity();
+  int total = 1;
+  for (int i = 0; i < d; ++i) total *= g;
+  for (int idx = 0; idx < total; ++idx) {
+    int r = idx;
+    for (int i = 0; i < d; ++i) {
+      const int gi = r % g;
+      r /= g;
+      const auto ii = static_cast<std::size_t>(i);
+      x[i] = box.lo[ii] + (box.hi[ii] - box.lo[ii]) * gi / (g - 1);
+    }
+    const double fx = f(x);
+    if (fx > fbest) {
+      fbest = fx;
+      best = x;
+    }
+  }
+  VectorXd step(d);
+  for (int i = 0; i < d; ++i) step[i] = (box.hi[static_cast<std::size_t>(i)] - box.lo[static_cast<std::size_t>(i)]) / (g - 1);
+  return pattern_search(f, box, best, step, fx_out);
+}
+
+std::string labels_text(const std::vector<int>& v) {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? "," : "") + std::to_string(v[i]);
+  return s;
+}
+
+ChiSquare pearson(const std::vector<std::uint64_t>& n, const std::vector<double>& p, int params_used, double* stat_out) {
+  ChiSquare r;
+  double total = 0.0;
+  for (const auto c : n) total += static_cast<double>(c);
+  int cells = 0;
+  for (std::size_t k = 0; k < n.size(); ++k) {
+    if (!(p[k] > 0.0)) continue;
+    ++cells;
+    const double e = total * p[k], dlt = static_cast<double>(n[k]) - e;
+    r.statistic += dlt * dlt / e;
+  }
+  r.dof = cells - 1 - params_used;
+  if (stat_out) *stat_out = r.statistic;
+  r.p_value = r.dof > 0 ? boost::math::cdf(boost::math::complement(boost::math::chi_squared(r.dof), r.statistic))
+                        : std::numeric_limits<double>::quiet_NaN();
+  return r;
+}
+
+class Fitter {
+ public:
+  Fitter(const std::vector<FitParam>& params, const std::vector<FitData>& data, const FitOptions& opt)
+      : params_(params), data_(data), opt_(opt), d_(static_cast<int>(params.size())) {}
+
+  FitResult run();
+
+ private:
+  std::vector<std::string> overrides_at(std::size_t s, const VectorXd& theta) const {
+    std::vector<std::string> all = opt_.overrides;
+    all.insert(all.end(), data_[s].overrides.begin(), data_[s].overrides.end());
+    for (int i = 0; i < d_; ++i) all.push_back(params_[static_cast<std::size_t>(i)].key + "=" + number_text(theta[i]));
+    return all;
+  }
+  DieModel model_at(std::size_t s, const VectorXd& theta) const {
+    return compile(load_scene(data_[s].scene, overrides_at(s, theta)), data_[s].scene);
+  }
+  std::vector<VectorXd> grid(const Box& box) const;
+  // Tosses every model with indices 0..tosses-1 in `batches` batches on the thread pool.
+  std::vector<PointCounts> simulate(const std::vector<DieModel>& models, std::uint64_t tosses, const std::string& stage);
+  Surrogate fit_surrogate(const Box& box, const std::vector<VectorXd>& design, const std::vector<std::vector<PointCounts>>& counts,
+                          int skip_batch) const;
+  double loglik(const Surrogate& sur, const VectorXd& theta) const {
+    double l = 0.0;
+    for (std::size_t s = 0; s < data_.size(); ++s) l += n_[s].dot(sur.log_p(s, theta));
+    return l;
+  }
+
+  const std::vector<FitParam>& params_;
+  const std::vector<FitData>& data_;
+  const FitOptions& opt_;
+  int d_;
+  std::vector<VectorXd> n_;                 // observed counts per data set, in the model's label order
+  std::vector<std::vector<int>> labels_;    // per data set
+  std::uint64_t done_ = 0, total_ = 0;      // tosses, for progress
+  std::uint64_t simulated_ = 0;
+};
+
+std::vector<VectorXd> Fitter::grid(const Box& box) const {
+  const int g = fit_grid_points(d_);
+  int total = 1;
+  for (int i = 0; i < d_; ++i) total *= g;
+  std::vector<VectorXd> pts;
+  for (int idx = 0; idx < total; ++idx) {
+    VectorXd x(d_);
+    int r = idx;
+    for (int i = 0; i < d_; ++i) {
+      const int gi = r % g;
+      r /= g;
+      const auto ii = static_cast<std::size_t>(i);
+      x[i] = gi == g - 1 ? box.hi[ii] : box.lo[ii] + (box.hi[ii] - box.lo[ii]) * gi / (g - 1);
+    }
+    pts.push_back(x);
+  }
+  return pts;
+}
+
+std::vector<PointCounts> Fitter::simulate(const std::vector<DieModel>& models, std::uint64_t tosses, const std::string& stage) {
+  const int B = opt_.batches;
+  struct Job {
+    std::size_t model;
+    int batch;
+    std::uint64_t lo, hi;
+  };
+  std::vector<Job> jobs;
+  constexpr std::uint64_t kJob = 256;  // small: the last jobs of a round balance the threads
+  for (std::size_t m = 0; m < models.size(); ++m)
+    for (int b = 0; b < B; ++b) {
+      const std::uint64_t lo = tosses * static_cast<std::uint64_t>(b) / static_cast<std::uint64_t>(B);
+      const std::uint64_t hi = tosses * static_cast<std::uint64_t>(b + 1) / static_cast<std::uint64_t>(B);
+      for (std::uint64_t a = lo; a < hi; a += kJob) jobs.push_back({m, b, a, std::min(hi, a + kJob)});
+    }
+  std::vector<PointCounts> out(models.size());
+  for (std::size_t m = 0; m < models.size(); ++m) {
+    out[m].faces.assign(static_cast<std::size_t>(B), std::vector<std::uint64_t>(static_cast<std::size_t>(models[m].outcomes()), 0));
+    out[m].settled.assign(static_cast<std::size_t>(B), 0);
+  }
+  std::atomic<std::size_t> next{0};
+  std::atomic<std::uint64_t> done{done_};
+  std::mutex mu;
+  auto work = [&] {
+    for (;;) {
+      if (opt_.cancel && opt_.cancel->load(std::memory_order_relaxed)) return;
+      const std::size_t j = next.fetch_add(1, std::memory_order_relaxed);
+      if (j >= jobs.size()) return;
+      const Job& job = jobs[j];
+      RunCounts local(models[job.model].outcomes());
+      for (std::uint64_t i = job.lo; i < job.hi; ++i) local.add(toss(models[job.model], opt_.seed, i));
+      {
+        std::lock_guard lock(mu);
+        auto& f = out[job.model].faces[static_cast<std::size_t>(job.batch)];
+        for (std::size_t k = 0; k < f.size(); ++k) f[k] += local.faces[k];
+        out[job.model].settled[static_cast<std::size_t>(job.batch)] += local.settled;
+      }
+      const std::uint64_t now = done.fetch_add(job.hi - job.lo) + (job.hi - job.lo);
+      if (opt_.progress) opt_.progress(stage, now, total_);
+    }
+  };
+  {
+    std::vector<std::jthread> pool;
+    for (int t = 1; t < std::max(1, opt_.threads); ++t) pool.emplace_back(work);
+    work();
+  }
+  if (opt_.cancel && opt_.cancel->load()) throw std::runtime_error("cancelled");
+  done_ = done.load();
+  simulated_ += tosses * models.size();
+  return out;
+}
+
+Surrogate Fitter::fit_surrogate(const Box& box, const std::vector<VectorXd>& design,
+                                const std::vector<std::vector<PointCounts>>& counts, int skip_batch) const {
+  Surrogate sur{Basis(d_, fit_surrogate_degree(d_)), box, {}};
+  std::vector<VectorXd> phi;
+  for (const VectorXd& x : design) phi.push_back(sur.basis.eval(box.scaled(x)));
+  for (std::size_t s = 0; s < data_.size(); ++s) {
+    std::vector<std::vector<double>> c;
+    std::vector<double> n;
+    for (const PointCounts& pc : counts[s]) {
+      std::vector<double> ck(pc.faces.front().size(), 0.0);
+      double nk = 0.0;
+      for (std::size_t b = 0; b < pc.faces.size(); ++b) {
+        if (static_cast<int>(b) == skip_batch) continue;
+        for (std::size_t k = 0; k < ck.size(); ++k) ck[k] += static_cast<double>(pc.faces[b][k]);
+        nk += static_cast<double>(pc.settled[b]);
+      }
+      c.push_back(std::move(ck));
+      n.push_back(nk);
+    }
+    sur.coef.push_back(fit_log_p(sur.basis, phi, c, n));
+  }
+  return sur;
+}
+
+FitResult Fitter::run() {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (d_ < 1 || d_ > 3) throw SceneError("dicesim fit", "--param", std::to_string(d_) + " parameters", "fit takes 1 to 3 parameters");
+  for (std::size_t i = 0; i < params_.size(); ++i) {
+    const FitParam& p = params_[i];
+    if (!(p.lo < p.hi) || !std::isfinite(p.lo) || !std::isfinite(p.hi))
+      throw SceneError("dicesim fit", "--param", p.key + "=" + number_text(p.lo) + ":" + number_text(p.hi),
+                       "LO must be below HI, both finite");
+    for (std::size_t j = 0; j < i; ++j)
+      if (params_[j].key == p.key) throw SceneError("dicesim fit", "--param", p.key, "given twice");
+  }
+  if (data_.empty()) throw SceneError("dicesim fit", "--data", "", "at least one data set is needed");
+  if (opt_.rounds < 1 || opt_.rounds > 10) throw SceneError("dicesim fit", "--rounds", std::to_string(opt_.rounds), "must be in [1, 10]");
+  if (opt_.batches < 4 || opt_.batches > 1000)
+    throw SceneError("dicesim fit", "batches", std::to_string(opt_.batches), "must be in [4, 1000]");
+  const std::uint64_t min_tosses = static_cast<std::uint64_t>(opt_.batches) << (opt_.rounds - 1);
+  if (opt_.tosses < std::max<std::uint64_t>(min_tosses, 1000))
+    throw SceneError("dicesim fit", "--tosses", std::to_string(opt_.tosses),
+                     "must be at least " + std::to_string(std::max<std::uint64_t>(min_tosses, 1000)));
+
+  Box box;
+  for (const FitParam& p : params_) {
+    box.lo.push_back(p.lo);
+    box.hi.push_back(p.hi);
+  }
+  const Box range = box;
+  std::vector<VectorXd> design = grid(box);
+  const int R = opt_.rounds;
+  const std::size_t S = data_.size();
+  auto round_tosses = [&](int r) { return opt_.tosses >> (R - 1 - r); };
+  for (int r = 0; r < R; ++r) total_ += round_tosses(r) * design.size() * S;
+  total_ += opt_.tosses * S;  // the fitted probabilities at the estimate
+
+  // Every model of the first round is compiled before the first toss: a bad key or value (the
+  // grid holds LO and HI of every parameter) fails at once.
+  std::vector<std::vector<DieModel>> models(S);
+  for (std::size_t s = 0; s < S; ++s) {
+    for (const VectorXd& x : design) models[s].push_back(model_at(s, x));
+    labels_.push_back(models[s].front().outcome_labels);
+    for (const DieModel& m : models[s])
+      if (m.outcome_labels != labels_[s])
+        throw SceneError(data_[s].scene, "outcomes", labels_text(m.outcome_labels),
+                         "the fitted keys must not change the die's outcomes (at the range's first value: " + labels_text(labels_[s]) + ")");
+    const FaceCounts& obs = data_[s].observed;
+    if (obs.labels.size() != obs.counts.size()) throw SceneError(data_[s].source, "counts", "", "labels and counts differ in number");
+    VectorXd n = VectorXd::Zero(static_cast<Eigen::Index>(labels_[s].size()));
+    for (std::size_t i = 0; i < obs.labels.size(); ++i) {
+      const auto it = std::find(labels_[s].begin(), labels_[s].end(), obs.labels[i]);
+      if (it == labels_[s].end())
+        throw SceneError(data_[s].source, "face", std::to_string(obs.labels[i]),
+                         "the die of " + data_[s].scene + " has no such outcome; its outcomes: " + labels_text(labels_[s]));
+      n[it - labels_[s].begin()] += static_cast<double>(obs.counts[i]);
+    }
+    if (n.sum() <= 0.0) throw SceneError(data_[s].source, "counts", "", "all counts are 0");
+    n_.push_back(n);
+  }
+
+  FitResult res;
+  Surrogate sur{Basis(d_, 0), box, {}};
+  std::vector<std::vector<PointCounts>> counts;
+  VectorXd theta(d_);
+  for (int r = 0; r < R; ++r) {
+    if (r > 0) {
+      for (std::size_t s = 0; s < S; ++s) {
+        models[s].clear();
+        for (const VectorXd& x : design) models[s].push_back(model_at(s, x));
+      }
+    }
+    const std::string stage = "round " + std::to_string(r + 1) + "/" + std::to_string(R);
+    counts.assign(S, {});
+    for (std::size_t s = 0; s < S; ++s) counts[s] = simulate(models[s], round_tosses(r), stage);
+    sur = fit_surrogate(box, design, counts, -1);
+    double lmax = 0.0;
+    theta = maximize([&](const VectorXd& x) { return loglik(sur, x); }, box, &lmax);
+
+    // Monte Carlo spread of the estimate: refitted without each batch (the same batch leaves every
+    // point, which keeps the common random numbers), searched from the full estimate.
+    const int B = opt_.batches;
+    std::vector<VectorXd> jk;
+    VectorXd step(d_);
+    for (int i = 0; i < d_; ++i) step[i] = 0.02 * (box.hi[static_cast<std::size_t>(i)] - box.lo[static_cast<std::size_t>(i)]);
+    for (int b = 0; b < B; ++b) {
+      const Surrogate sb = fit_surrogate(box, design, counts, b);
+      jk.push_back(pattern_search([&](const VectorXd& x) { return loglik(sb, x); }, box, theta, step));
+    }
+    VectorXd mean = VectorXd::Zero(d_);
+    for (const VectorXd& t : jk) mean += t / static_cast<double>(B);
+    VectorXd var = VectorXd::Zero(d_);
+    for (const VectorXd& t : jk) var += (t - mean).cwiseAbs2();
+    const VectorXd mc_sd = (var * (static_cast<double>(B - 1) / B)).cwiseSqrt();
+
+    // Profiles: each parameter on a grid over the box, the others maximised (warm-started along it).
+    res.params.assign(static_cast<std::size_t>(d_), {});
+    for (int i = 0; i < d_; ++i) {
+      const auto ii = static_cast<std::size_t>(i);
+      FitParamResult& pr = res.params[ii];
+      pr.key = params_[ii].key;
+      pr.lo = params_[ii].lo;
+      pr.hi = params_[ii].hi;
+      auto profile_at = [&, i](double t, VectorXd& warm) {
+        if (d_ == 1) {
+          VectorXd x(1);
+          x[0] = t;
+          return loglik(sur, x);
+        }
+        Box sub;
+        std::vector<int> dims;
+        for (int k = 0; k < d_; ++k)
+          if (k != i) {
+            dims.push_back(k);
+            sub.lo.push_back(box.lo[static_cast<std::size_t>(k)]);
+            sub.hi.push_back(box.hi[static_cast<std::size_t>(k)]);
+          }
+        auto g = [&](const VectorXd& y) {
+          VectorXd x(d_);
+          x[i] = t;
+          for (std::size_t k = 0; k < dims.size(); ++k) x[dims[k]] = y[static_cast<Eigen::Index>(k)];
+          return loglik(sur, x);
+        };
+        VectorXd st(static_cast<Eigen::Index>(dims.size()));
+        for (std::size_t k = 0; k < dims.size(); ++k) st[static_cast<Eigen::Index>(k)] = 0.05 * (sub.hi[k] - sub.lo[k]);
+        double fw = 0.0, ft = 0.0;
+        VectorXd from_theta(static_cast<Eigen::Index>(dims.size()));
+        for (std::size_t k = 0; k < dims.size(); ++k) from_theta[static_cast<Eigen::Index>(k)] = theta[dims[k]];
+        VectorXd a = pattern_search(g, sub, warm.size() ? warm : from_theta, st, &fw);
+        VectorXd b2 = pattern_search(g, sub, from_theta, st, &ft);
+        warm = fw >= ft ? a : b2;
+        return std::max(fw, ft);
+      };
+      constexpr int kProfile = 101;
+      const double blo = box.lo[ii], bhi = box.hi[ii];
+      std::vector<double> ts, ls;
+      VectorXd warm;
+      // From the estimate outwards on both sides, so the warm start follows the ridge.
+      std::vector<double> grid_t;
+      for (int k = 0; k < kProfile; ++k) grid_t.push_back(k == kProfile - 1 ? bhi : blo + (bhi - blo) * k / (kProfile - 1));
+      std::vector<double> prof(grid_t.size());
+      const auto centre = static_cast<std::size_t>(std::lower_bound(grid_t.begin(), grid_t.end(), theta[i]) - grid_t.begin());
+      warm = VectorXd();
+      for (std::size_t k = centre; k < grid_t.size(); ++k) prof[k] = profile_at(grid_t[k], warm);
+      warm = VectorXd();
+      for (std::size_t k = centre; k-- > 0;) prof[k] = profile_at(grid_t[k], warm);
+      double lbest = lmax;
+      for (const double v : prof) lbest = std::max(lbest, v);
+      for (std::size_t k = 0; k < grid_t.size(); ++k) pr.profile.push_back({grid_t[k], 2.0 * (lbest - prof[k])});
+      // The interval's ends: the first grid value past the cut on each side, then bisection.
+      auto end_on = [&](int dir, bool& open) {
+        VectorXd w;
+        double inside = theta[i];
+        const long size = static_cast<long>(grid_t.size());
+        long k = static_cast<long>(centre);
+        if (dir < 0 && (k >= size || grid_t[static_cast<std::size_t>(k)] > theta[i])) --k;
+        for (; k >= 0 && k < size; k += dir) {
+          const double t = grid_t[static_cast<std::size_t>(k)];
+          if (2.0 * (lbest - prof[static_cast<std::size_t>(k)]) >= kChi2Level95) {
+            double a = inside, b = t;
+            for (int it = 0; it < 60; ++it) {
+              const double mid = 0.5 * (a + b);
+              (2.0 * (lbest - profile_at(mid, w)) >= kChi2Level95 ? b : a) = mid;
+            }
+            open = false;
+            return 0.5 * (a + b);
+          }
+          inside = t;
+        }
+        open = true;
+        return dir < 0 ? blo : bhi;
+      };
+      bool lo_open = false, hi_open = false;
+      pr.ci95_profile = {end_on(-1, lo_open), end_on(+1, hi_open)};
+      pr.lo_open = lo_open && blo <= params_[ii].lo;
+      pr.hi_open = hi_open && bhi >= params_[ii].hi;
+      pr.estimate = theta[i];
+      pr.mc_sd = mc_sd[i];
+      const double z = kZ95 * pr.mc_sd;
+      pr.ci95.lo = std::max(params_[ii].lo, pr.estimate - std::hypot(pr.estimate - pr.ci95_profile.lo, z));
+      pr.ci95.hi = std::min(params_[ii].hi, pr.estimate + std::hypot(pr.ci95_profile.hi - pr.estimate, z));
+    }
+    FitRound fr;
+    fr.box_lo = box.lo;
+    fr.box_hi = box.hi;
+    fr.points = design.size();
+    fr.tosses_per_point = round_tosses(r);
+    for (int i = 0; i < d_; ++i) fr.estimate.push_back(theta[i]);
+    res.rounds.push_back(fr);
+    res.loglik = lmax;
+
+    if (r + 1 < R) {  // the next box: the interval widened 2.5x about the estimate, inside LO..HI
+      Box next;
+      for (int i = 0; i < d_; ++i) {
+        const auto ii = static_cast<std::size_t>(i);
+        const FitParamResult& pr = res.params[ii];
+        const double min_w = 1e-3 * (range.hi[ii] - range.lo[ii]);
+        double lo = std::max(range.lo[ii], theta[i] - std::max(2.5 * (theta[i] - pr.ci95.lo), min_w));
+        double hi = std::min(range.hi[ii], theta[i] + std::max(2.5 * (pr.ci95.hi - theta[i]), min_w));
+        next.lo.push_back(lo);
+        next.hi.push_back(hi);
+      }
+      box = next;
+      design = grid(box);
+    }
+  }
+
+  // The ideal (Fisher) half-widths at the estimate: I = sum_s N_s sum_k grad p_k grad p_k^T / p_k.
+  MatrixXd info = MatrixXd::Zero(d_, d_);
+  for (std::size_t s = 0; s < S; ++s) {
+    const VectorXd p = sur.log_p(s, theta).array().exp();
+    MatrixXd grad(p.size(), d_);
+    for (int i = 0; i < d_; ++i) {
+      const double h = 1e-4 * (box.hi[static_cast<std::size_t>(i)] - box.lo[static_cast<std::size_t>(i)]);
+      VectorXd a = theta, b = theta;
+      a[i] += h;
+      b[i] -= h;
+      grad.col(i) = (sur.log_p(s, a).array().exp() - sur.log_p(s, b).array().exp()) / (2.0 * h);
+    }
+    for (Eigen::Index k = 0; k < p.size(); ++k) info += n_[s].sum() * grad.row(k).transpose() * grad.row(k) / p[k];
+  }
+  const Eigen::FullPivLU<MatrixXd> lu(info);
+  const MatrixXd cov = lu.isInvertible() ? MatrixXd(lu.inverse()) : MatrixXd::Constant(d_, d_, std::numeric_limits<double>::quiet_NaN());
+  for (int i = 0; i < d_; ++i)
+    res.params[static_cast<std::size_t>(i)].fisher_halfwidth = cov(i, i) > 0.0 ? kZ95 * std::sqrt(cov(i, i)) : std::numeric_limits<double>::quiet_NaN();
+
+  // The fitted probabilities: simulated at the estimate, with the goodness of fit.
+  double stat = 0.0;
+  int cells = 0;
+  for (std::size_t s = 0; s < S; ++s) {
+    const std::vector<DieModel> at{model_at(s, theta)};
+    const PointCounts pc = simulate(at, opt_.tosses, "fitted")[0];
+    FitDataResult dr;
+    dr.scene = data_[s].scene;
+    dr.source = data_[s].source;
+    dr.labels = labels_[s];
+    dr.fitted_tosses = opt_.tosses;
+    std::uint64_t settled = 0;
+    std::vector<std::uint64_t> f(labels_[s].size(), 0);
+    for (std::size_t b = 0; b < pc.faces.size(); ++b) {
+      settled += pc.settled[b];
+      for (std::size_t k = 0; k < f.size(); ++k) f[k] += pc.faces[b][k];
+    }
+    for (std::size_t k = 0; k < f.size(); ++k) {
+      dr.observed.push_back(static_cast<std::uint64_t>(n_[s][static_cast<Eigen::Index>(k)]));
+      dr.fitted.push_back(settled ? static_cast<double>(f[k]) / static_cast<double>(settled) : 0.0);
+    }
+    double st = 0.0;
+    dr.gof = pearson(dr.observed, dr.fitted, 0, &st);
+    stat += st;
+    for (const double p : dr.fitted) cells += p > 0.0 ? 1 : 0;
+    cells -= 1;
+    res.data.push_back(std::move(dr));
+  }
+  res.gof.statistic = stat;
+  res.gof.dof = cells - d_;
+  res.gof.p_value = res.gof.dof > 0
+                        ? boost::math::cdf(boost::math::complement(boost::math::chi_squared(res.gof.dof), stat))
+                        : std::numeric_limits<double>::quiet_NaN();
+  res.simulated_tosses = simulated_;
+  res.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+}  // namespace
+
+int fit_grid_points(int params) { return params <= 1 ? 7 : params == 2 ? 5 : 4; }
+int fit_surrogate_degree(int params) { return params <= 2 ? 3 : 2; }
+
+FitParam parse_fit_param(const std::string& text, const std::string& origin) {
+  const auto eq = text.rfind('=');
+  const auto colon = eq == std::string::npos ? std::string::npos : text.find(':', eq);
+  auto bad = [&](const std::string& why) { return SceneError(origin, "--param", text, why); };
+  if (eq == std::string::npos || eq == 0 || colon == std::string::npos)
+    throw bad("expected KEY=LO:HI, e.g. floor.restitution=0.2:0.8");
+  FitParam p;
+  p.key = text.substr(0, eq);
+  const std::string a = text.substr(eq + 1, colon - eq - 1), b = text.substr(colon + 1);
+  char* ea = nullptr;
+  char* eb = nullptr;
+  p.lo = std::strtod(a.c_str(), &ea);
+  p.hi = std::strtod(b.c_str(), &eb);
+  if (a.empty() || b.empty() || *ea != '\0' || *eb != '\0' || !std::isfinite(p.lo) || !std::isfinite(p.hi))
+    throw bad("LO and HI must be numbers, e.g. floor.restitution=0.2:0.8");
+  if (!(p.lo < p.hi)) throw bad("LO must be below HI");
+  return p;
+}
+
+FitResult run_fit(const std::vector<FitParam>& params, const std::vector<FitData>& data, const FitOptions& opt) {
+  return Fitter(params, data, opt).run();
+}
+
+}  // namespace dicesim

@@ -1,0 +1,114 @@
+// From counts back to the die: scene parameters fitted to observed tosses by simulation-based
+// maximum likelihood.
+//
+// The observed counts n_k of a data set are multinomial with the die's outcome probabilities
+// p_k(theta), theta = one to three numeric scene keys. p(theta) is known only by simulation, so:
+//  1. Design: a grid over a box of theta; every point is tossed with the same seed and toss
+//     indices (common random numbers: two points differ only through theta, so the estimates are
+//     smooth in theta and their differences precise).
+//  2. Surrogate: per data set and outcome, log p_k(theta) is fitted by a polynomial (weighted
+//     least squares, weights from each point's binomial variance); p~ = softmax of the fits.
+//  3. Likelihood: l(theta) = sum over data sets and outcomes of n_k log p~_k(theta); the estimate
+//     maximises it over the box, and each parameter's 95% interval is where its profile
+//     (the others maximised) is within chi2_1(0.95)/2 = 1.92 of the maximum.
+//  4. Adaptive: the next round's box is the interval widened 2.5x (clipped to LO..HI) with twice
+//     the tosses, so the last surrogate is local and precise; `rounds` rounds in all.
+//  5. Monte Carlo error: each point's tosses are split into batches of consecutive indices; the
+//     estimate is refitted without each batch in turn (a jackknife that keeps the common random
+//     numbers: the same batch leaves every point), and its standard deviation is added to the
+//     interval in quadrature.
+// The fitted probabilities are then simulated at the estimate, with Pearson's chi-square of the
+// counts against them. Randomness comes only from (seed, toss index): the same inputs give the
+// same fit on any number of threads. Pure computation: nothing here prints.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "sim/study/compare.hpp"
+#include "sim/study/statistics.hpp"
+
+namespace dicesim {
+
+struct FitParam {
+  std::string key;  // a numeric scene key, as for --set (e.g. floor.restitution)
+  double lo = 0.0;
+  double hi = 1.0;
+};
+
+// "KEY=LO:HI" (LO < HI, both finite). Throws SceneError naming `origin`, "--param" and the text.
+FitParam parse_fit_param(const std::string& text, const std::string& origin = "dicesim fit");
+
+// One data set: observed counts of one die in one scene.
+struct FitData {
+  std::string scene;                   // scene file
+  std::vector<std::string> overrides;  // after FitOptions::overrides
+  std::string source;                  // where the counts came from, for messages (e.g. the CSV)
+  FaceCounts observed;
+};
+
+struct FitOptions {
+  std::vector<std::string> overrides;  // every data set's, before its own (--set, sim.fidelity)
+  std::uint64_t seed = 1;
+  int threads = 1;
+  // Tosses per design point and data set in the last round; round r of R takes tosses / 2^(R-1-r).
+  std::uint64_t tosses = 40000;
+  int rounds = 3;
+  int batches = 16;  // for the Monte Carlo error (jackknife); each point's tosses in this many
+  // (stage, tosses done, tosses in the whole fit), from any thread, about every few hundred tosses.
+  std::function<void(const std::string&, std::uint64_t, std::uint64_t)> progress;
+  const std::atomic<bool>* cancel = nullptr;  // stops at the next job: run_fit then throws
+};
+
+// Design points per parameter and polynomial degree of the surrogate, by number of parameters.
+int fit_grid_points(int params);
+int fit_surrogate_degree(int params);
+
+struct FitParamResult {
+  std::string key;
+  double lo = 0.0, hi = 0.0;    // the range searched
+  double estimate = 0.0;
+  Interval ci95;                // profile likelihood, widened by the Monte Carlo error
+  Interval ci95_profile;        // the surrogate's profile likelihood alone
+  double mc_sd = 0.0;           // Monte Carlo standard deviation of the estimate (jackknife)
+  double fisher_halfwidth = 0;  // the ideal 95% half-width, 1.96 sqrt((I^-1)_ii), NaN if I is singular
+  bool lo_open = false;         // the interval reaches LO (or HI): the data do not bound it there
+  bool hi_open = false;
+  std::vector<std::array<double, 2>> profile;  // (value, 2 (l_max - l_profile)) over the last box
+};
+
+struct FitDataResult {
+  std::string scene, source;
+  std::vector<int> labels;              // the die's outcomes, ascending
+  std::vector<std::uint64_t> observed;  // per label
+  std::vector<double> fitted;           // simulated at the estimate, per label
+  std::uint64_t fitted_tosses = 0;
+  ChiSquare gof;                        // this data set against `fitted`, dof = outcomes - 1
+};
+
+struct FitRound {
+  std::vector<double> box_lo, box_hi;   // per parameter
+  std::uint64_t points = 0, tosses_per_point = 0;
+  std::vector<double> estimate;
+};
+
+struct FitResult {
+  std::vector<FitParamResult> params;
+  std::vector<FitDataResult> data;
+  ChiSquare gof;  // all data sets together, dof = sum(outcomes - 1) - parameters
+  double loglik = 0.0;
+  std::uint64_t simulated_tosses = 0;
+  double elapsed_s = 0.0;
+  std::vector<FitRound> rounds;
+};
+
+// Validates first (1-3 distinct parameters, every scene loading at each parameter's LO and HI,
+// observed labels that the die has, counts not all zero: SceneError naming the file or key), then
+// fits. Throws std::runtime_error("cancelled") if `cancel` was set.
+FitResult run_fit(const std::vector<FitParam>& params, const std::vector<FitData>& data, const FitOptions& opt);
+
+}  // namespace dicesim
