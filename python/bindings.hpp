@@ -76,5 +76,6 @@ int resolve_threads(int threads);
 void register_scene(pb::module_& m);
 void register_toss(pb::module_& m);
 void register_trace(pb::module_& m);
+void register_fit(pb::module_& m);  // fit_binding.cpp
 
 }  // namespace dicesim::py

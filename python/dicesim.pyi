@@ -1,5 +1,5 @@
 """Type stubs of the dicesim extension module (python/*.cpp). Docstrings: help(dicesim)."""
-from typing import Any, Callable, Iterable, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Iterable, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -119,3 +119,14 @@ def sweep_file(
     fidelity: Optional[str] = None,
     progress: Progress = None,
 ) -> Sweep: ...
+def fit(
+    scene: Union[Scene, str, Sequence[Union[Scene, str]]],
+    data: Union[str, Mapping[int, int], Sequence[Union[str, Mapping[int, int]]]],
+    params: Union[Mapping[str, Tuple[float, float]], Sequence[str]],
+    n: int = 40000,
+    rounds: int = 3,
+    seed: int = 1,
+    threads: int = 0,
+    fidelity: Optional[str] = None,
+    progress: Progress = None,
+) -> dict[str, Any]: ...
