@@ -26,7 +26,7 @@ namespace fs = std::filesystem;
 struct FitArgs {
   SceneArgs scene;
   std::vector<std::string> data, scenes, params;
-  std::uint64_t tosses = 40000;
+  std::uint64_t tosses = 0;  // automatic
   int rounds = 3;
   std::uint64_t seed = 1;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -77,6 +77,9 @@ void print_text(const FitResult& r, const FitArgs& a, const std::string& fidelit
     std::printf("%-28s %12.6g   %-27s %12.3g %14.4g\n", p.key.c_str(), p.estimate, iv, p.mc_sd, p.fisher_halfwidth);
   }
   for (const FitParamResult& p : r.params) {
+    if (p.mc_large)
+      std::printf("note: %s's Monte Carlo sd is over half the data's: the interval may be too narrow (raise --tosses)\n",
+                  p.key.c_str());
     if (p.lo_open)
       std::printf("note: %s's interval reaches the range's low end %g: the data do not bound it there (widen --param)\n",
                   p.key.c_str(), p.lo);
@@ -179,8 +182,9 @@ void register_fit(CLI::App& app, int& exit_code) {
       ->required()
       ->type_name("KEY=LO:HI");
   cmd->add_option("-n,--tosses", a->tosses,
-                  "Tosses per grid point and data set in the last round (earlier rounds: half, a quarter, ...)")
-      ->capture_default_str()
+                  "Tosses per grid point and data set in the last round (earlier rounds: half, a quarter, ...).\n"
+                  "Default: 20 per observed toss of the largest data set, at least 40000 (fewer make the\n"
+                  "intervals too narrow once the simulation's noise rivals the data's: docs/fitting.md)")
       ->check(CLI::Range(1000ULL, 1ULL << 34));
   cmd->add_option("--rounds", a->rounds, "Rounds of the adaptive design (each narrows the grid)")
       ->capture_default_str()

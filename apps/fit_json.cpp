@@ -21,6 +21,7 @@ nlohmann::json fit_json(const FitResult& r, const FitOptions& opt, const std::st
                       {"ci95_open", {p.lo_open, p.hi_open}},
                       {"ci95_profile", {num(p.ci95_profile.lo), num(p.ci95_profile.hi)}},
                       {"mc_sd", num(p.mc_sd)},
+                      {"mc_large", p.mc_large},
                       {"fisher_halfwidth", num(p.fisher_halfwidth)}});
   // "fitted": one entry per outcome of every data set (with several, "data" tells them apart).
   nlohmann::json fitted = nlohmann::json::array(), data = nlohmann::json::array();

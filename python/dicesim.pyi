@@ -123,7 +123,7 @@ def fit(
     scene: Union[Scene, str, Sequence[Union[Scene, str]]],
     data: Union[str, Mapping[int, int], Sequence[Union[str, Mapping[int, int]]]],
     params: Union[Mapping[str, Tuple[float, float]], Sequence[str]],
-    n: int = 40000,
+    n: int = 0,
     rounds: int = 3,
     seed: int = 1,
     threads: int = 0,

@@ -105,7 +105,7 @@ pb::object do_fit(const pb::object& scene, const pb::object& data, const pb::obj
 }  // namespace
 
 void register_fit(pb::module_& m) {
-  m.def("fit", &do_fit, pb::arg("scene"), pb::arg("data"), pb::arg("params"), pb::arg("n") = 40000, pb::arg("rounds") = 3,
+  m.def("fit", &do_fit, pb::arg("scene"), pb::arg("data"), pb::arg("params"), pb::arg("n") = 0, pb::arg("rounds") = 3,
         pb::arg("seed") = 1, pb::arg("threads") = 0, pb::arg("fidelity") = pb::none(), pb::arg("progress") = pb::none(),
         "Fit one to three numeric scene keys to observed counts: `dicesim fit`. Returns the dict that\n"
         "`dicesim fit --json` prints: params (key, estimate, ci95, ...), fitted (label, p, observed),\n"
@@ -113,7 +113,8 @@ void register_fit(pb::module_& m) {
         "scene: a Scene loaded from a file, or a path; data: a counts file (CSV face,count or toss JSON)\n"
         "or a dict {label: count}. Several data sets fit shared keys jointly: lists of scenes and data\n"
         "of the same length (or one scene for every data set).\n"
-        "params: {key: (lo, hi)} or ['KEY=LO:HI', ...]. n: tosses per grid point in the last round.\n"
+        "params: {key: (lo, hi)} or ['KEY=LO:HI', ...]. n: tosses per grid point in the last round\n"
+        "(0: automatic, 20 per observed toss, at least 40000).\n"
         "    dicesim.fit('scenes/paper/die1.toml', 'data/seed-experiments/die1_counts.csv',\n"
         "                {'materials.steel.density': (3000, 20000)}, fidelity='impulse')\n"
         "GIL, Ctrl-C and progress(done, total) as in toss(). Bad input raises SceneError.");

@@ -223,6 +223,7 @@ class Fitter {
   std::vector<std::vector<int>> labels_;    // per data set
   std::uint64_t done_ = 0, total_ = 0;      // tosses, for progress
   std::uint64_t simulated_ = 0;
+  std::uint64_t tosses_ = 0;               // per point in the last round
 };
 
 std::vector<VectorXd> Fitter::grid(const Box& box) const {
@@ -336,8 +337,9 @@ FitResult Fitter::run() {
   if (opt_.batches < 4 || opt_.batches > 1000)
     throw SceneError("dicesim fit", "batches", std::to_string(opt_.batches), "must be in [4, 1000]");
   const std::uint64_t min_tosses = static_cast<std::uint64_t>(opt_.batches) << (opt_.rounds - 1);
-  if (opt_.tosses < std::max<std::uint64_t>(min_tosses, 1000))
-    throw SceneError("dicesim fit", "--tosses", std::to_string(opt_.tosses),
+  tosses_ = opt_.tosses ? opt_.tosses : fit_auto_tosses(data_);
+  if (tosses_ < std::max<std::uint64_t>(min_tosses, 1000))
+    throw SceneError("dicesim fit", "--tosses", std::to_string(tosses_),
                      "must be at least " + std::to_string(std::max<std::uint64_t>(min_tosses, 1000)));
 
   Box box;
@@ -349,9 +351,9 @@ FitResult Fitter::run() {
   std::vector<VectorXd> design = grid(box);
   const int R = opt_.rounds;
   const std::size_t S = data_.size();
-  auto round_tosses = [&](int r) { return opt_.tosses >> (R - 1 - r); };
+  auto round_tosses = [&](int r) { return tosses_ >> (R - 1 - r); };
   for (int r = 0; r < R; ++r) total_ += round_tosses(r) * design.size() * S;
-  total_ += opt_.tosses * S;  // the fitted probabilities at the estimate
+  total_ += tosses_ * S;  // the fitted probabilities at the estimate
 
   // Every model of the first round is compiled before the first toss: a bad key or value (the
   // grid holds LO and HI of every parameter) fails at once.
@@ -497,6 +499,7 @@ FitResult Fitter::run() {
       const double z = kZ95 * pr.mc_sd;
       pr.ci95.lo = std::max(params_[ii].lo, pr.estimate - std::hypot(pr.estimate - pr.ci95_profile.lo, z));
       pr.ci95.hi = std::min(params_[ii].hi, pr.estimate + std::hypot(pr.ci95_profile.hi - pr.estimate, z));
+      pr.mc_large = pr.mc_sd > 0.5 * (pr.ci95_profile.hi - pr.ci95_profile.lo) / (2.0 * kZ95);
     }
     FitRound fr;
     fr.box_lo = box.lo;
@@ -547,12 +550,12 @@ FitResult Fitter::run() {
   int cells = 0;
   for (std::size_t s = 0; s < S; ++s) {
     const std::vector<DieModel> at{model_at(s, theta)};
-    const PointCounts pc = simulate(at, opt_.tosses, "fitted")[0];
+    const PointCounts pc = simulate(at, tosses_, "fitted")[0];
     FitDataResult dr;
     dr.scene = data_[s].scene;
     dr.source = data_[s].source;
     dr.labels = labels_[s];
-    dr.fitted_tosses = opt_.tosses;
+    dr.fitted_tosses = tosses_;
     std::uint64_t settled = 0;
     std::vector<std::uint64_t> f(labels_[s].size(), 0);
     for (std::size_t b = 0; b < pc.faces.size(); ++b) {
@@ -581,6 +584,12 @@ FitResult Fitter::run() {
 }
 
 }  // namespace
+
+std::uint64_t fit_auto_tosses(const std::vector<FitData>& data) {
+  std::uint64_t observed_max = 0;
+  for (const FitData& d : data) observed_max = std::max(observed_max, d.observed.total());
+  return std::max<std::uint64_t>(kAutoTossesMin, kAutoTossesPerObserved * observed_max);
+}
 
 int fit_grid_points(int params) { return params <= 1 ? 7 : params == 2 ? 5 : 4; }
 int fit_surrogate_degree(int params) { return params <= 2 ? 3 : 2; }

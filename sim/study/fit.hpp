@@ -56,13 +56,20 @@ struct FitOptions {
   std::uint64_t seed = 1;
   int threads = 1;
   // Tosses per design point and data set in the last round; round r of R takes tosses / 2^(R-1-r).
-  std::uint64_t tosses = 40000;
+  // 0: automatic, fit_auto_tosses(data).
+  std::uint64_t tosses = 0;
   int rounds = 3;
   int batches = 16;  // for the Monte Carlo error (jackknife); each point's tosses in this many
   // (stage, tosses done, tosses in the whole fit), from any thread, about every few hundred tosses.
   std::function<void(const std::string&, std::uint64_t, std::uint64_t)> progress;
   const std::atomic<bool>* cancel = nullptr;  // stops at the next job: run_fit then throws
 };
+
+// The automatic tosses per point: 20 per observed toss of the largest data set, at least 40 000.
+// Fewer leave the surrogate noisy enough to overstate its slope, and the intervals too narrow
+// (docs/fitting.md, "Coverage").
+inline constexpr std::uint64_t kAutoTossesMin = 40000, kAutoTossesPerObserved = 20;
+std::uint64_t fit_auto_tosses(const std::vector<FitData>& data);
 
 // Design points per parameter and polynomial degree of the surrogate, by number of parameters.
 int fit_grid_points(int params);
@@ -78,6 +85,7 @@ struct FitParamResult {
   double fisher_halfwidth = 0;  // the ideal 95% half-width, 1.96 sqrt((I^-1)_ii), NaN if I is singular
   bool lo_open = false;         // the interval reaches LO (or HI): the data do not bound it there
   bool hi_open = false;
+  bool mc_large = false;        // mc_sd above half the profile's sd: raise the tosses
   std::vector<std::array<double, 2>> profile;  // (value, 2 (l_max - l_profile)) over the last box
 };
 
