@@ -9,8 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "sim/models/compile.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/scene_error.hpp"
+#include "sim/study/monte_carlo.hpp"
 
 namespace dicesim {
 namespace {
@@ -673,6 +675,59 @@ TEST(SceneShapes, BadShapeKeysNameKeyValueAndRange) {
   const SceneError faces = shape_error("shape = \"d8\"\n[die.faces]\n\"+z\" = 1\n");
   EXPECT_EQ(faces.key(), "die.faces");
   expect_contains(faces.allowed(), "[[die.labels]]");
+}
+
+}  // namespace
+}  // namespace dicesim
+
+// ---- [floor] friction (what `dicesim fit` varies) ------------------------------------------------
+namespace dicesim {
+namespace {
+
+// Every contact of every kind of body takes the floor's friction: corners of a sharp polyhedron,
+// of a rounded one, and a coin's rim features. max_friction follows (the stepper and rest use it).
+TEST(SceneFloor, FrictionOverridesEveryContact) {
+  for (const char* scene : {"paper/die1.toml", "dice/d6.toml", "coins/quarter-table.toml"}) {
+    SCOPED_TRACE(scene);
+    const SceneDef plain = load_scene(kScenes + scene);
+    EXPECT_FALSE(plain.floor.friction.has_value());
+    const DieModel before = compile(plain);
+    ASSERT_FALSE(before.vertex_friction.empty());
+    EXPECT_NE(before.vertex_friction.front(), 0.7);  // the materials' 0.3: the override must show
+
+    const SceneDef set = load_scene(kScenes + scene, {"floor.friction=0.7"});
+    EXPECT_EQ(set.floor.friction, 0.7);
+    const DieModel m = compile(set);
+    ASSERT_EQ(m.vertex_friction.size(), before.vertex_friction.size());
+    for (double mu : m.vertex_friction) EXPECT_EQ(mu, 0.7);
+    EXPECT_EQ(m.max_friction, 0.7);
+    EXPECT_EQ(m.vertex_restitution, before.vertex_restitution);  // friction only
+  }
+  EXPECT_EQ(parse_scene(kMinimal + "[floor]\nfriction = 0\n", "x").floor.friction, 0.0);
+}
+
+TEST(SceneFloor, FrictionChangesImpulseResults) {
+  RunConfig cfg;
+  cfg.seed = 3;
+  cfg.tosses = 300;
+  auto counts = [&](const std::string& mu) {
+    return run_tosses(compile(load_scene(kDie1, {"sim.fidelity=impulse", "floor.friction=" + mu})), cfg).faces;
+  };
+  EXPECT_NE(counts("0.05"), counts("0.9"));
+}
+
+TEST(SceneErrors, FloorFrictionOutOfRange) {
+  for (const char* bad : {"10.5", "-0.1"}) {
+    const SceneError e = error_of([&] { load_scene(kDie1, {std::string("floor.friction=") + bad}); });
+    EXPECT_EQ(e.file(), std::string(kDie1) + " (--set)");
+    EXPECT_EQ(e.key(), "floor.friction");
+    EXPECT_EQ(e.value(), bad);
+    EXPECT_EQ(e.allowed(), "must be a number in [0, 10]");
+  }
+  const SceneError in_file = parse_error(kMinimal + "[floor]\nfriction = \"high\"\n");
+  EXPECT_EQ(in_file.file(), "mem.toml");
+  EXPECT_EQ(in_file.key(), "floor.friction");
+  EXPECT_EQ(in_file.allowed(), "must be a number in [0, 10]");
 }
 
 }  // namespace

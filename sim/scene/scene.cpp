@@ -535,6 +535,7 @@ void read_throw(Reader th, ThrowDef& def) {
 
 void read_floor(Reader floor, FloorDef& def) {
   if (auto e = floor.number("restitution", kRestitution)) def.restitution = e;
+  if (auto mu = floor.number("friction", kFriction)) def.friction = mu;
   floor.finish();
 }
 
