@@ -13,7 +13,8 @@ void SceneArgs::add_to(CLI::App* cmd) {
   cmd->add_option("SCENE", path, "Scene file (TOML), e.g. scenes/paper/die1.toml")->required();
   cmd->add_option("--set", overrides,
                   "Override a scene key, KEY=VALUE in TOML syntax; repeatable.\n"
-                  "e.g. --set materials.steel.restitution=1.0 --set throw.spin.sd=30")
+                  "e.g. --set materials.steel.restitution=1.0 --set throw.spin.sd=30\n"
+                  "Array elements by index: --set 'die.regions[0].cuts[0].offset=0.005'")
       ->type_name("KEY=VALUE");
   cmd->add_option("--fidelity", fidelity, "Physical model (the scene's sim.fidelity otherwise): static, paper, impulse, stepped, auto")
       ->type_name("F");

@@ -52,6 +52,19 @@ TEST(CliSweep, JsonHasEveryPointAndFace) {
   }
 }
 
+// An indexed key (an element of an array of tables) sweeps like a dotted one: moving die 1's steel
+// slab's face down by 8 mm moves the COM, so the two points' counts differ.
+TEST(CliSweep, IndexedKey) {
+  const CliRun r = cli("sweep scenes/paper/die1.toml --param 'die.regions[0].cuts[0].offset' --values 0,0.008 -n 400 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["param"], "die.regions[0].cuts[0].offset");
+  ASSERT_EQ(j["points"].size(), 2u);
+  EXPECT_NE(j["points"][0]["faces"], j["points"][1]["faces"]);
+  expect_bad_input(cli("sweep scenes/paper/die1.toml --param 'die.regions[2].cuts[0].offset' --values 0"),
+                   {"(--set)", "die.regions[2].cuts[0].offset", "index 2 is out of range", "1 element"});
+}
+
 // Each point carries its corrections (issue 13: every guard counted and reported), the same as a
 // toss of that point reports, and the table names the points where any is non-zero. The quarter on
 // a table is the scene with the most (unconverged rim solves); where all are 0 the line is absent.

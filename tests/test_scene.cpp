@@ -9,8 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "sim/models/compile.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/scene_error.hpp"
+#include "sim/study/monte_carlo.hpp"
 
 namespace dicesim {
 namespace {
@@ -673,6 +675,147 @@ TEST(SceneShapes, BadShapeKeysNameKeyValueAndRange) {
   const SceneError faces = shape_error("shape = \"d8\"\n[die.faces]\n\"+z\" = 1\n");
   EXPECT_EQ(faces.key(), "die.faces");
   expect_contains(faces.allowed(), "[[die.labels]]");
+}
+
+}  // namespace
+}  // namespace dicesim
+
+// ---- [floor] friction and indexed --set keys (what `dicesim fit` varies) ---------------------------
+namespace dicesim {
+namespace {
+
+// Every contact of every kind of body takes the floor's friction: corners of a sharp polyhedron,
+// of a rounded one, and a coin's rim features. max_friction follows (the stepper and rest use it).
+TEST(SceneFloor, FrictionOverridesEveryContact) {
+  for (const char* scene : {"paper/die1.toml", "dice/d6.toml", "coins/quarter-table.toml"}) {
+    SCOPED_TRACE(scene);
+    const SceneDef plain = load_scene(kScenes + scene);
+    EXPECT_FALSE(plain.floor.friction.has_value());
+    const DieModel before = compile(plain);
+    ASSERT_FALSE(before.vertex_friction.empty());
+    EXPECT_NE(before.vertex_friction.front(), 0.7);  // the materials' 0.3: the override must show
+
+    const SceneDef set = load_scene(kScenes + scene, {"floor.friction=0.7"});
+    EXPECT_EQ(set.floor.friction, 0.7);
+    const DieModel m = compile(set);
+    ASSERT_EQ(m.vertex_friction.size(), before.vertex_friction.size());
+    for (double mu : m.vertex_friction) EXPECT_EQ(mu, 0.7);
+    EXPECT_EQ(m.max_friction, 0.7);
+    EXPECT_EQ(m.vertex_restitution, before.vertex_restitution);  // friction only
+  }
+  EXPECT_EQ(parse_scene(kMinimal + "[floor]\nfriction = 0\n", "x").floor.friction, 0.0);
+}
+
+TEST(SceneFloor, FrictionChangesImpulseResults) {
+  RunConfig cfg;
+  cfg.seed = 3;
+  cfg.tosses = 300;
+  auto counts = [&](const std::string& mu) {
+    return run_tosses(compile(load_scene(kDie1, {"sim.fidelity=impulse", "floor.friction=" + mu})), cfg).faces;
+  };
+  EXPECT_NE(counts("0.05"), counts("0.9"));
+}
+
+TEST(SceneErrors, FloorFrictionOutOfRange) {
+  for (const char* bad : {"10.5", "-0.1"}) {
+    const SceneError e = error_of([&] { load_scene(kDie1, {std::string("floor.friction=") + bad}); });
+    EXPECT_EQ(e.file(), std::string(kDie1) + " (--set)");
+    EXPECT_EQ(e.key(), "floor.friction");
+    EXPECT_EQ(e.value(), bad);
+    EXPECT_EQ(e.allowed(), "must be a number in [0, 10]");
+  }
+  const SceneError in_file = parse_error(kMinimal + "[floor]\nfriction = \"high\"\n");
+  EXPECT_EQ(in_file.file(), "mem.toml");
+  EXPECT_EQ(in_file.key(), "floor.friction");
+  EXPECT_EQ(in_file.allowed(), "must be a number in [0, 10]");
+}
+
+// Die 1's steel slab is z >= 0 ((0, 0, -1) . x <= offset); offset 5 mm moves its face down to
+// z = -5 mm: 20 mm of steel over 10 mm of aluminium, so the COM drops from 3.65 mm to 2.79 mm.
+TEST(SceneOverride, IndexedKeyMovesARegionsCut) {
+  const SceneDef s = load_scene(kDie1, {"die.regions[0].cuts[0].offset=0.005"});
+  ASSERT_EQ(s.die.regions.size(), 1u);
+  ASSERT_EQ(s.die.regions[0].half_spaces.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.die.regions[0].half_spaces[0].offset, 0.005);
+  EXPECT_EQ(s.die.regions[0].half_spaces[0].normal, Vec3(0, 0, -1));  // its sibling is kept
+  EXPECT_EQ(s.die.regions[0].material, "steel");
+
+  const double steel = 7848.0, alu = 2714.3, a = 0.03;
+  const MassProperties before = compile(load_scene(kDie1)).mass_geometric;
+  const MassProperties after = compile(s).mass_geometric;
+  EXPECT_NEAR(before.com.z(), (steel - alu) * 0.0075 / (steel + alu), 1e-12);
+  EXPECT_NEAR(after.com.z(), (steel * 0.02 * 0.005 - alu * 0.01 * 0.01) / (steel * 0.02 + alu * 0.01), 1e-12);
+  EXPECT_LT(after.com.z(), before.com.z());
+  EXPECT_NEAR(after.mass, a * a * (steel * 0.02 + alu * 0.01), 1e-12);
+
+  // The key may end in an index: that element is replaced (here the cut's normal flips to z <= 0).
+  const SceneDef flipped = load_scene(kDie1, {"die.regions[0].cuts[0].normal[2]=1"});
+  EXPECT_EQ(flipped.die.regions[0].half_spaces[0].normal, Vec3(0, 0, 1));
+  EXPECT_NEAR(compile(flipped).mass_geometric.com.z(), -before.com.z(), 1e-12);
+  // Later overrides still win, indexed or not.
+  EXPECT_DOUBLE_EQ(load_scene(kDie1, {"die.regions[0].cuts[0].offset=0.001", "die.regions[0].cuts[0].offset=0.002"})
+                       .die.regions[0].half_spaces[0].offset,
+                   0.002);
+}
+
+// The walk is over the merged tree: an index reaches a region that a base scene defines.
+TEST(SceneOverride, IndexedKeyReachesAnArrayFromTheBase) {
+  TempDir dir;
+  dir.write("base.toml", kMinimal + "[materials.lead]\ndensity = 11340.0\n[[die.regions]]\nmaterial = \"lead\"\n"
+                                    "cuts = [{ normal = [1, 0, 0], offset = 0.0 }]\n");
+  const std::string top = dir.write("top.toml", "extends = \"base.toml\"\n[throw.height]\nmean = 0.5\n");
+  const SceneDef s = load_scene(top, {"die.regions[0].cuts[0].offset=-0.004", "die.regions[0].material=wood"});
+  EXPECT_DOUBLE_EQ(s.die.regions[0].half_spaces[0].offset, -0.004);
+  EXPECT_EQ(s.die.regions[0].material, "wood");
+}
+
+TEST(SceneErrors, IndexedOverride) {
+  const std::string set = std::string(kDie1) + " (--set)";
+  // Out of range: names the key, the index and the array's length.
+  const SceneError range = error_of([] { load_scene(kDie1, {"die.regions[1].cuts[0].offset=0"}); });
+  EXPECT_EQ(range.file(), set);
+  EXPECT_EQ(range.key(), "die.regions[1].cuts[0].offset");
+  EXPECT_EQ(range.allowed(), "index 1 is out of range: die.regions has 1 element (indices 0 to 0)");
+  const SceneError inner = error_of([] { load_scene(kDie1, {"die.regions[0].cuts[0].normal[3]=1"}); });
+  EXPECT_EQ(inner.allowed(), "index 3 is out of range: die.regions[0].cuts[0].normal has 3 elements (indices 0 to 2)");
+
+  // An index into something that is not an array.
+  const SceneError scalar = error_of([] { load_scene(kDie1, {"die.size[0]=0.02"}); });
+  EXPECT_EQ(scalar.file(), set);
+  EXPECT_EQ(scalar.key(), "die.size[0]");
+  EXPECT_EQ(scalar.allowed(), "die.size is a number, not an array: it cannot take the index [0]");
+  const SceneError table = error_of([] { load_scene(kDie1, {"die.faces[0]=1"}); });
+  expect_contains(table.allowed(), "die.faces is a table, not an array");
+
+  // The array must exist (die 1 states no [[die.labels]]), and a dotted key after an index needs a table.
+  const SceneError absent = error_of([] { load_scene(kDie1, {"die.labels[0].label=3"}); });
+  EXPECT_EQ(absent.key(), "die.labels[0].label");
+  expect_contains(absent.allowed(), "die.labels is not in the scene");
+  const SceneError into_number = error_of([] { load_scene(kDie1, {"die.regions[0].cuts[0].normal[0].x=1"}); });
+  EXPECT_EQ(into_number.allowed(), "die.regions[0].cuts[0].normal[0] is a number, not a table: it has no key 'x'");
+
+  // Malformed indices.
+  for (const char* bad : {"die.regions[-1].material=steel", "die.regions[x].material=steel", "die.regions[0.material=steel",
+                          "die.regions[0]x.material=steel", "die.[0].material=steel"}) {
+    const SceneError e = error_of([&] { load_scene(kDie1, {bad}); });
+    EXPECT_EQ(e.file(), set) << bad;
+    expect_contains(e.allowed(), "malformed override");
+  }
+  EXPECT_EQ(error_of([] { load_scene(kDie1, {"extends[0]=x.toml"}); }).file(), set);
+
+  // Values set by index are checked later like any other and carry the (--set) name; so do the
+  // tables a dotted key after an index creates.
+  const SceneError value = error_of([] { load_scene(kDie1, {"die.regions[0].cuts[0].offset=far"}); });
+  EXPECT_EQ(value.file(), set);
+  EXPECT_EQ(value.key(), "die.regions[0].cuts[0].offset");
+  EXPECT_EQ(value.value(), "\"far\"");
+  const SceneError element = error_of([] { load_scene(kDie1, {"die.regions[0].cuts[0].normal[1]=true"}); });
+  EXPECT_EQ(element.file(), set);
+  EXPECT_EQ(element.key(), "die.regions[0].cuts[0].normal[1]");
+  const SceneError created = error_of([] { load_scene(kDie1, {"die.regions[0].cuts[0].extra.depth=1"}); });
+  EXPECT_EQ(created.file(), set);
+  EXPECT_EQ(created.key(), "die.regions[0].cuts[0].extra");
+  expect_contains(created.allowed(), "unknown key 'extra'");
 }
 
 }  // namespace

@@ -175,7 +175,7 @@ DieModel compile_cylinder(const Body& body, const SceneDef& scene, const std::st
   rim.half = body.cylinder.core_half();
   for (int f = 0; f < kRimFeatures; ++f) {
     m.vertex_restitution.push_back(scene.floor.restitution ? *scene.floor.restitution : body.vertex_restitution[f]);
-    m.vertex_friction.push_back(body.vertex_friction[f]);
+    m.vertex_friction.push_back(scene.floor.friction ? *scene.floor.friction : body.vertex_friction[f]);
     m.vertex_rolling.push_back(body.vertex_rolling[f]);
     m.vertex_pivoting.push_back(body.vertex_pivoting[f]);
   }
@@ -226,7 +226,7 @@ DieModel compile_body(const Body& body, const SceneDef& scene, const std::string
   for (std::size_t c = 0; c < nv; ++c) {
     m.vertices[c] = m.geo_to_body * (shape.vertices[c] - mp.com);
     m.vertex_restitution[c] = scene.floor.restitution ? *scene.floor.restitution : body.vertex_restitution[c];
-    m.vertex_friction[c] = body.vertex_friction[c];
+    m.vertex_friction[c] = scene.floor.friction ? *scene.floor.friction : body.vertex_friction[c];
     reach = std::max(reach, m.vertices[c].norm());
   }
   m.bounding_radius = reach + m.rounding;

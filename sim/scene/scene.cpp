@@ -11,7 +11,9 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <system_error>
 #include <utility>
+#include <vector>
 
 #include <toml++/toml.h>
 
@@ -535,6 +537,7 @@ void read_throw(Reader th, ThrowDef& def) {
 
 void read_floor(Reader floor, FloorDef& def) {
   if (auto e = floor.number("restitution", kRestitution)) def.restitution = e;
+  if (auto mu = floor.number("friction", kFriction)) def.friction = mu;
   floor.finish();
 }
 
@@ -651,37 +654,121 @@ std::string trim(std::string_view s) {
   return b == std::string_view::npos ? "" : std::string(s.substr(b, e - b + 1));
 }
 
-// "a.b.c=VALUE": VALUE is TOML if it parses, else a bare string. The override is parsed as a
-// one-line TOML document with source "SCENE (--set)" and merged like one more file on top, so the tables
-// it creates and the value it sets carry that name into any error message.
+// `toml_key = VALUE` as a one-line TOML document with source "SCENE (--set)", so every node it holds
+// carries that name into any error message. VALUE is TOML if it parses, else a bare string.
+toml::table override_doc(const std::string& toml_key, const std::string& value, const std::string& source) {
+  if (value.find_first_of("\r\n") == std::string::npos) {  // a newline could smuggle in more keys
+    try {
+      return toml::parse(toml_key + " = " + value, std::string_view(source));
+    } catch (const toml::parse_error&) {
+    }
+  }
+  return parse_toml(toml_key + " = " + toml_string(value), source);
+}
+
+const char* type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    default: return "a date or time";
+  }
+}
+
+// One dotted segment of an override's key: a key, then the array indices after it ("cuts[0]").
+struct KeyStep {
+  std::string name;
+  std::vector<std::size_t> indices;
+};
+
+// "a.b.c=VALUE", merged like one more file on top (missing tables are created). A key with indices,
+// "die.regions[0].cuts[0].offset=VALUE", walks the merged tree instead: arrays of tables have no
+// dotted form, and an index must name an element that is already there (a new one would be a
+// region or cut with its other keys missing).
 void apply_override(toml::table& tree, const std::string& text, const std::string& origin) {
   const std::string source = set_origin(origin);
   const auto eq = text.find('=');
   const std::string key = trim(text.substr(0, eq == std::string::npos ? text.size() : eq));
   auto bad = [&](const std::string& why) { return SceneError(source, key.empty() ? text : key, "", why); };
   if (eq == std::string::npos) throw bad("malformed override '" + text + "': expected KEY=VALUE, e.g. sim.stop_speed=0.05");
+  const std::string malformed = "malformed override '" + text +
+                                "': KEY must be a dotted key such as sim.stop_speed, each part optionally followed by "
+                                "array indices such as die.regions[0]";
 
-  std::string toml_key;
+  std::vector<KeyStep> steps;
   std::size_t start = 0;
   for (std::size_t dot; start <= key.size(); start = dot + 1) {
     dot = std::min(key.find('.', start), key.size());
-    const std::string segment = trim(std::string_view(key).substr(start, dot - start));
-    if (segment.empty()) throw bad("malformed override '" + text + "': KEY must be a dotted key such as sim.stop_speed");
-    toml_key += (toml_key.empty() ? "" : ".") + toml_string(segment);
+    std::string_view segment = std::string_view(key).substr(start, dot - start);
+    KeyStep step;
+    const auto bracket = segment.find('[');
+    step.name = trim(segment.substr(0, bracket));
+    if (step.name.empty()) throw bad(malformed);
+    for (std::string_view rest = bracket == std::string_view::npos ? "" : segment.substr(bracket); !trim(rest).empty();) {
+      rest = rest.substr(rest.find_first_not_of(" \t"));
+      const auto close = rest.find(']');
+      const std::string digits = rest.front() == '[' && close != std::string_view::npos ? trim(rest.substr(1, close - 1)) : "";
+      std::size_t index = 0;
+      const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), index);
+      if (digits.empty() || ec != std::errc() || end != digits.data() + digits.size()) throw bad(malformed);
+      step.indices.push_back(index);
+      rest = rest.substr(close + 1);
+    }
+    steps.push_back(std::move(step));
   }
-  if (key == "extends" || key.rfind("extends.", 0) == 0)
+  if (steps.front().name == "extends")
     throw bad("cannot be overridden: write a scene file that extends the other one");
 
   const std::string value = trim(std::string_view(text).substr(eq + 1));
-  std::optional<toml::table> doc;
-  if (value.find_first_of("\r\n") == std::string::npos) {  // a newline could smuggle in more keys
-    try {
-      doc = toml::parse(toml_key + " = " + value, std::string_view(source));
-    } catch (const toml::parse_error&) {
+  auto dotted = [&](std::size_t from) {
+    std::string toml_key;
+    for (std::size_t i = from; i < steps.size(); ++i) toml_key += (toml_key.empty() ? "" : ".") + toml_string(steps[i].name);
+    return toml_key;
+  };
+  std::size_t last_indexed = steps.size();
+  for (std::size_t i = 0; i < steps.size(); ++i)
+    if (!steps[i].indices.empty()) last_indexed = i;
+  if (last_indexed == steps.size()) {
+    merge(tree, override_doc(dotted(0), value, source));
+    return;
+  }
+
+  // Down to the last indexed element; everything on the way must exist.
+  toml::node* at = &tree;
+  std::string walked;  // the key so far, as the message names it
+  for (std::size_t i = 0; i <= last_indexed; ++i) {
+    const KeyStep& step = steps[i];
+    toml::table* t = at->as_table();
+    if (!t)
+      throw bad(walked + " is " + type_name(*at) + ", not a table: it has no key '" + step.name + "'");
+    walked = child_path(walked, step.name);
+    at = t->get(step.name);
+    if (!at) throw bad(walked + " is not in the scene: an indexed key can only name an element that exists");
+    for (std::size_t k = 0; k < step.indices.size(); ++k) {
+      const std::size_t index = step.indices[k];
+      toml::array* a = at->as_array();
+      if (!a) throw bad(walked + " is " + type_name(*at) + ", not an array: it cannot take the index [" + std::to_string(index) + "]");
+      if (index >= a->size())
+        throw bad("index " + std::to_string(index) + " is out of range: " + walked + " has " + std::to_string(a->size()) +
+                  (a->size() == 1 ? " element" : " elements") +
+                  (a->empty() ? "" : " (indices 0 to " + std::to_string(a->size() - 1) + ")"));
+      walked += "[" + std::to_string(index) + "]";
+      if (i == last_indexed && k + 1 == step.indices.size() && last_indexed + 1 == steps.size()) {
+        // The key ends in an index: that element is replaced.
+        toml::table doc = override_doc("v", value, source);
+        a->replace(a->cbegin() + static_cast<std::ptrdiff_t>(index), std::move(*doc.get("v")));
+        return;
+      }
+      at = a->get(index);
     }
   }
-  if (!doc) doc = parse_toml(toml_key + " = " + toml_string(value), source);
-  merge(tree, std::move(*doc));
+  toml::table* element = at->as_table();
+  if (!element)
+    throw bad(walked + " is " + type_name(*at) + ", not a table: it has no key '" + steps[last_indexed + 1].name + "'");
+  merge(*element, override_doc(dotted(last_indexed + 1), value, source));
 }
 
 std::string stem_or(const std::string& path, const std::string& fallback) {

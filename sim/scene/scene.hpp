@@ -142,6 +142,8 @@ struct FloorDef {
   // When set, every contact uses this restitution instead of the die material's
   // (the seed's sec. 5.8 sweep: "same for all corners").
   std::optional<double> restitution;
+  // Likewise friction, in [0, 10]: the table's own coefficient, so that a fit can vary it alone.
+  std::optional<double> friction;
 };
 
 // `impulse`'s default contact step. A polyhedron's sustained contact is mostly events (each new
