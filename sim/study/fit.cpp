@@ -468,27 +468,27 @@ FitResult Fitter::run() {
       for (const double v : prof) lbest = std::max(lbest, v);
       for (std::size_t k = 0; k < grid_t.size(); ++k) pr.profile.push_back({grid_t[k], 2.0 * (lbest - prof[k])});
       // The interval's ends: the first grid value past the cut on each side, then bisection.
+      // The interval is the hull of the confidence set {t : 2 (l_max - l_profile(t)) < 3.84}: each
+      // end is found from the box's edge inwards (the first grid value inside the set, then
+      // bisection), so a second mode that the data cannot tell from the first stays inside it.
       auto end_on = [&](int dir, bool& open) {
         VectorXd w;
-        double inside = theta[i];
         const long size = static_cast<long>(grid_t.size());
-        long k = static_cast<long>(centre);
-        if (dir < 0 && (k >= size || grid_t[static_cast<std::size_t>(k)] > theta[i])) --k;
-        for (; k >= 0 && k < size; k += dir) {
-          const double t = grid_t[static_cast<std::size_t>(k)];
-          if (2.0 * (lbest - prof[static_cast<std::size_t>(k)]) >= kChi2Level95) {
-            double a = inside, b = t;
-            for (int it = 0; it < 60; ++it) {
-              const double mid = 0.5 * (a + b);
-              (2.0 * (lbest - profile_at(mid, w)) >= kChi2Level95 ? b : a) = mid;
-            }
-            open = false;
-            return 0.5 * (a + b);
-          }
-          inside = t;
+        auto inside_set = [&](long k) { return 2.0 * (lbest - prof[static_cast<std::size_t>(k)]) < kChi2Level95; };
+        long k = dir < 0 ? 0 : size - 1;
+        if (inside_set(k)) {
+          open = true;
+          return dir < 0 ? blo : bhi;
         }
-        open = true;
-        return dir < 0 ? blo : bhi;
+        while (!inside_set(k - dir) && (k - dir) != static_cast<long>(centre)) k -= dir;
+        double out = grid_t[static_cast<std::size_t>(k)], in = grid_t[static_cast<std::size_t>(k - dir)];
+        if (!inside_set(k - dir)) in = theta[i];  // only the estimate's own neighbourhood is inside
+        for (int it = 0; it < 60; ++it) {
+          const double mid = 0.5 * (out + in);
+          (2.0 * (lbest - profile_at(mid, w)) >= kChi2Level95 ? out : in) = mid;
+        }
+        open = false;
+        return 0.5 * (out + in);
       };
       bool lo_open = false, hi_open = false;
       pr.ci95_profile = {end_on(-1, lo_open), end_on(+1, hi_open)};
