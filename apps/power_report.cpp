@@ -45,6 +45,8 @@ json common(const PowerRunInfo& info, const std::vector<int>& labels, const Simu
           {"n_approx", opt(est.n_approx)},
           {"n_exact", opt(est.exact.n)},
           {"n_range95", {opt(est.n_range95[0]), opt(est.n_range95[1])}},
+          {"n_range95_approx", {opt(est.n_range95_approx[0]), opt(est.n_range95_approx[1])}},
+          {"n_exact_replicate_sd", est.replicate_sd},
           {"exact", exact_json(est.exact)},
           {"elapsed_s", info.elapsed_s}};
 }
@@ -76,11 +78,14 @@ std::string verdict(const PowerRunInfo& info, const PowerEstimate& e, int dof, c
   t += format("  exact (simulated counts, %llu replicates):  %s", static_cast<unsigned long long>(c.target.replicates),
               n_text(e.exact.n).c_str());
   if (e.exact.n)
-    t += format("   (at n: power %.3f, size %.3f, critical value %.3f)", e.exact.at.power, e.exact.at.size,
-                e.exact.at.critical);
+    t += format(" +/- %.0f   (at n: power %.3f, size %.3f, critical value %.3f)", e.replicate_sd, e.exact.at.power,
+                e.exact.at.size, e.exact.at.critical);
   t += format("\n  noncentral chi-square approximation:       %s\n", n_text(e.n_approx).c_str());
   t += format("  95%% range from the tosses' own noise:      [%s, %s]  (bootstrap of %d batches, %d resamples)\n",
               n_text(e.n_range95[0]).c_str(), n_text(e.n_range95[1]).c_str(), c.batches, c.bootstrap);
+  if (e.exact.n)
+    t += format("  (+/- : the exact n's sd from its %llu replicates alone; the range: from the tosses alone)\n",
+                static_cast<unsigned long long>(c.target.replicates));
   t += format("%.2f s\n", info.elapsed_s);
   return t;
 }

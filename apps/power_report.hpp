@@ -33,7 +33,9 @@ inline constexpr double kPowerDifferenceLevel = 0.05;
 //  "settled_a", "p_a", "p_a_ci95": [[lo, hi]...], and with --against "settled_b", "p_b", "p_b_ci95",
 //  "w2" (sum (p_b - p_a)^2 / p_a; null if infinite), "difference": {"statistic", "dof", "p_value",
 //  "significant"};
-//  "n_approx", "n_exact", "n_range95": [lo, hi] (null: not reached by 2^40 throws),
+//  "n_approx", "n_exact", "n_range95": [lo, hi] (n_exact scaled by the bootstrap quantiles of the
+//  approximate n), "n_range95_approx" (those quantiles), "n_exact_replicate_sd" (null n: not
+//  reached by 2^40 throws),
 //  "exact": {"n", "power", "size", "critical", "evaluations"} (the simulated test at n_exact),
 //  with --detect-bias "hardest": {"face", "sign"} and "alternatives": [{"face", "sign", "p_face", "w2",
 //  "n_approx", "n_exact", "power_at_n"}], and "elapsed_s"}.

@@ -268,9 +268,13 @@ TEST(Power, StudiesDoNotDependOnThreads) {
   rc.seed = 5;
   rc.tosses = 20000;
   EXPECT_EQ(s1.a.counts, run_tosses(a, rc));
-  // The range holds the estimate's approximation (bootstrap quantiles around it).
-  ASSERT_TRUE(s1.estimate.n_range95[0] && s1.estimate.n_range95[1]);
-  EXPECT_LE(*s1.estimate.n_range95[0], *s1.estimate.n_range95[1]);
+  // The range: the exact n scaled by the approximation's bootstrap quantiles, around the estimate.
+  ASSERT_TRUE(s1.estimate.n_range95[0] && s1.estimate.n_range95[1] && s1.estimate.n_range95_approx[1]);
+  EXPECT_LE(*s1.estimate.n_range95[0], *s1.estimate.exact.n);
+  EXPECT_GE(*s1.estimate.n_range95[1], *s1.estimate.exact.n);
+  EXPECT_NEAR(static_cast<double>(*s1.estimate.n_range95[1]) / static_cast<double>(*s1.estimate.exact.n),
+              static_cast<double>(*s1.estimate.n_range95_approx[1]) / static_cast<double>(*s1.estimate.n_approx), 1e-3);
+  EXPECT_GT(s1.estimate.replicate_sd, 0.0);
 
   const BiasStudy d1 = power_detect_bias(a, 0.02, small_study(1));
   const BiasStudy d2 = power_detect_bias(a, 0.02, small_study(2));
@@ -311,7 +315,7 @@ TEST(CliPower, JsonIsOneObjectAndMatchesTheTable) {
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   for (const char* key : {"mode", "scene", "against", "labels", "p_a", "p_b", "p_a_ci95", "alpha", "power", "n_exact",
-                          "n_approx", "n_range95", "replicates", "simulated_tosses", "elapsed_s", "difference", "exact"})
+                          "n_approx", "n_range95", "n_range95_approx", "n_exact_replicate_sd", "replicates", "simulated_tosses", "elapsed_s", "difference", "exact"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["mode"], "against");
   EXPECT_EQ(j["simulated_tosses"], 40000);

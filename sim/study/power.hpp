@@ -133,9 +133,14 @@ struct SimulatedDie {
 struct PowerEstimate {
   std::optional<std::uint64_t> n_approx;
   ExactN exact;
-  // 95% bootstrap range of n: the exact n at the resamples whose approximate n are the 2.5% and
-  // 97.5% quantiles (nullopt: not reached, e.g. no difference in that resample).
-  std::array<std::optional<std::uint64_t>, 2> n_range95;
+  // How much n moves with the tosses' own noise: the 2.5% and 97.5% quantiles of the approximate n
+  // over a paired bootstrap of the toss batches (n_range95_approx), and the exact n scaled by them
+  // (n_range95 = n_exact * quantile / n_approx at the tosses' probabilities). nullopt: not reached
+  // (no difference in those resamples).
+  std::array<std::optional<std::uint64_t>, 2> n_range95, n_range95_approx;
+  // The exact n's own noise from the finite replicates (not in the range): the power's binomial
+  // sd sqrt(P (1 - P) / R) over the slope d power / d n of the approximation at n_exact.
+  double replicate_sd = 0.0;
 };
 
 struct AgainstStudy {
