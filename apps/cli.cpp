@@ -89,6 +89,7 @@ int run_cli(int argc, char** argv) {
   register_calibrate(app, exit_code);
   register_compare(app, exit_code);
   register_fit(app, exit_code);
+  register_power(app, exit_code);
   register_worker(app, exit_code);
   register_aggregate(app, exit_code);
   register_run(app, exit_code);

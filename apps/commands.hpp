@@ -41,6 +41,7 @@ void register_sweep(CLI::App& app, int& exit_code);      // cmd_sweep.cpp
 void register_calibrate(CLI::App& app, int& exit_code);  // cmd_calibrate.cpp
 void register_compare(CLI::App& app, int& exit_code);    // cmd_compare.cpp
 void register_fit(CLI::App& app, int& exit_code);        // cmd_fit.cpp
+void register_power(CLI::App& app, int& exit_code);      // cmd_power.cpp
 void register_worker(CLI::App& app, int& exit_code);
 void register_aggregate(CLI::App& app, int& exit_code);
 void register_run(CLI::App& app, int& exit_code);

@@ -77,5 +77,6 @@ void register_scene(pb::module_& m);
 void register_toss(pb::module_& m);
 void register_trace(pb::module_& m);
 void register_fit(pb::module_& m);  // fit_binding.cpp
+void register_power(pb::module_& m);  // power_binding.cpp
 
 }  // namespace dicesim::py

@@ -130,3 +130,18 @@ def fit(
     fidelity: Optional[str] = None,
     progress: Progress = None,
 ) -> dict[str, Any]: ...
+def power(
+    scene: Scene,
+    *,
+    against: Optional[Scene] = None,
+    detect_bias: Optional[float] = None,
+    n: int = 100000,
+    alpha: float = 0.05,
+    power: float = 0.8,
+    replicates: int = 4000,
+    bootstrap: int = 1000,
+    seed: int = 1,
+    threads: int = 0,
+    fidelity: Optional[str] = None,
+    progress: Progress = None,
+) -> dict[str, Any]: ...  # exactly `dicesim power --json`'s object

@@ -70,8 +70,8 @@ PYBIND11_MODULE(dicesim, m) {
       "    r = dicesim.toss(scene, 100_000)\n"
       "    r.labels, r.counts, r.p, r.ci95    # numpy arrays, faces by label\n"
       "    r.to_dict()                        # exactly `dicesim toss --json`'s object\n\n"
-      "Functions: load_scene, scene_from_toml, toss, toss_one, sweep, sweep_file, fit. Bad scene input\n"
-      "raises SceneError (a ValueError) with the message the command line prints.";
+      "Functions: load_scene, scene_from_toml, toss, toss_one, sweep, sweep_file, fit, power. Bad scene\n"
+      "input raises SceneError (a ValueError) with the message the command line prints.";
   m.attr("__version__") = "0.1.0";
 
   // SceneError: a ValueError carrying the CLI's exit-2 message and its parts.
@@ -97,4 +97,5 @@ PYBIND11_MODULE(dicesim, m) {
   py::register_toss(m);
   py::register_trace(m);
   py::register_fit(m);
+  py::register_power(m);
 }
