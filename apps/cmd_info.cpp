@@ -14,7 +14,7 @@ namespace {
 
 Vec3 geometric_normal(const DieModel& m, std::size_t f) { return m.geo_to_body.transpose() * m.face_normals[f]; }
 
-void print_info(const std::string& path, const DieModel& m) {
+void print_info(const std::string& path, const DieModel& m, const FloorDef& floor) {
   const MassProperties& mp = m.mass_geometric;
   std::printf("%s%s%s\n\n", path.c_str(), m.name.empty() ? "" : ": ", m.name.c_str());
   std::printf("shape              %s: %d corners, %d faces, %d outcomes, read %s%s\n", m.kind.c_str(), m.vertex_count(),
@@ -51,7 +51,12 @@ void print_info(const std::string& path, const DieModel& m) {
     else
       std::printf("   %s\n", m.face_hold[f] >= 0.0 ? "none (the only basin)" : "-");
   }
-  std::printf("\ncorners (restitution, friction: volume mix of the materials at the corner)\n");
+  // Where the two numbers come from: the materials at the corner, or the scene's [floor] values.
+  auto source = [](const char* what, bool from_floor) {
+    return std::string(what) + (from_floor ? ": [floor] " + std::string(what) + " for every contact" : ": volume mix of the materials at the corner");
+  };
+  std::printf("\ncorners (%s; %s)\n", source("restitution", floor.restitution.has_value()).c_str(),
+              source("friction", floor.friction.has_value()).c_str());
   for (std::size_t c = 0; c < m.vertices.size(); ++c) {
     const Vec3 geo = m.geo_to_body.transpose() * m.vertices[c] + mp.com;
     std::printf("  %4zu  (%+.6f, %+.6f, %+.6f)  e = %.4f  mu = %.3f\n", c, geo.x(), geo.y(), geo.z(),
@@ -93,11 +98,12 @@ void register_info(CLI::App& app, int& exit_code) {
   cmd->add_flag("--json", args->json, "One JSON object: shape, vertex_count, face_count, faces [{label, normal, area, stable,\n"
                 "p_static}], mass, com, inertia (3x3), principal_moments, ...");
   cmd->callback([args, &exit_code] {
-    const DieModel m = compile(args->scene.load(), args->scene.path);
+    const SceneDef def = args->scene.load();
+    const DieModel m = compile(def, args->scene.path);
     if (args->json)
       std::printf("%s\n", info_json(args->scene.path, m).dump(2).c_str());
     else
-      print_info(args->scene.path, m);
+      print_info(args->scene.path, m, def.floor);
     exit_code = kExitOk;
   });
 }

@@ -61,6 +61,19 @@ TEST(Cli, TableIsReadable) {
   EXPECT_NE(r.out.find("settled"), std::string::npos);
 }
 
+// The corner table says where its restitution and friction come from: the materials, or [floor].
+TEST(Cli, InfoNamesTheFloorOverrides) {
+  const CliRun plain = cli("info scenes/paper/die1.toml");
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  EXPECT_NE(plain.out.find("friction: volume mix of the materials"), std::string::npos) << plain.out;
+  const CliRun set = cli("info scenes/paper/die1.toml --set floor.friction=0.7 --set floor.restitution=0.4");
+  ASSERT_EQ(set.code, 0) << set.err;
+  EXPECT_NE(set.out.find("friction: [floor] friction for every contact"), std::string::npos) << set.out;
+  EXPECT_NE(set.out.find("restitution: [floor] restitution for every contact"), std::string::npos) << set.out;
+  EXPECT_NE(set.out.find("mu = 0.700"), std::string::npos);
+  EXPECT_NE(set.out.find("e = 0.4000"), std::string::npos);
+}
+
 TEST(Cli, InfoJsonHasMassProperties) {
   const CliRun r = cli("info scenes/paper/die3.toml --json");
   ASSERT_EQ(r.code, 0) << r.err;
