@@ -8,7 +8,7 @@ import pytest
 from conftest import SOURCE_DIR, require
 
 
-@pytest.mark.parametrize("script", ["sweep_aluminium.py", "single_toss.py"])
+@pytest.mark.parametrize("script", ["sweep_aluminium.py", "single_toss.py", "fit_die1.py"])
 def test_example_writes_png(script, tmp_path):
     require("matplotlib")
     out = tmp_path / (script[:-3] + ".png")
