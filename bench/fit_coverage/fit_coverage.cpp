@@ -2,7 +2,8 @@
 // synthetic data (N tosses of SCENE at KEY = TRUTH, data seed 1000 + rep) and its own simulation
 // seed (5000 + rep). Prints one CSV line per repetition, then the coverage with its Wilson interval
 // and the mean interval width against the ideal (Fisher) width.
-//   fit_coverage SCENE FIDELITY KEY TRUTH LO HI N REPS TOSSES [THREADS]
+//   fit_coverage SCENE FIDELITY KEY TRUTH LO HI N REPS TOSSES [THREADS] [FIRST]
+// FIRST (default 0): the first repetition's index, so a long study can run in parts.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -19,7 +20,7 @@ using namespace dicesim;
 
 int main(int argc, char** argv) {
   if (argc < 10) {
-    std::fprintf(stderr, "usage: fit_coverage SCENE FIDELITY KEY TRUTH LO HI N REPS TOSSES [THREADS]\n");
+    std::fprintf(stderr, "usage: fit_coverage SCENE FIDELITY KEY TRUTH LO HI N REPS TOSSES [THREADS] [FIRST]\n");
     return 2;
   }
   const std::string scene = argv[1], fidelity = argv[2], key = argv[3];
@@ -27,6 +28,7 @@ int main(int argc, char** argv) {
   const auto n = std::strtoull(argv[7], nullptr, 10), reps = std::strtoull(argv[8], nullptr, 10),
              tosses = std::strtoull(argv[9], nullptr, 10);
   const int threads = argc > 10 ? std::atoi(argv[10]) : 2;
+  const std::uint64_t first = argc > 11 ? std::strtoull(argv[11], nullptr, 10) : 0;
   const std::vector<std::string> fid{"sim.fidelity=\"" + fidelity + "\""};
   std::vector<std::string> at_truth = fid;
   at_truth.push_back(key + "=" + number_text(truth));
@@ -36,7 +38,7 @@ int main(int argc, char** argv) {
   std::uint64_t covered = 0, covered_profile = 0, open = 0;
   double width = 0.0, ideal = 0.0, est = 0.0, mc = 0.0;
   std::printf("rep,estimate,lo,hi,profile_lo,profile_hi,mc_sd,fisher_halfwidth,covers\n");
-  for (std::uint64_t rep = 0; rep < reps; ++rep) {
+  for (std::uint64_t rep = first; rep < first + reps; ++rep) {
     RunConfig cfg;
     cfg.seed = 1000 + rep;
     cfg.tosses = n;
