@@ -13,7 +13,6 @@
 #include "apps/fit_json.hpp"
 #include "apps/gnuplot.hpp"
 #include "apps/progress.hpp"
-#include "sim/models/compile.hpp"
 #include "sim/scene/scene_error.hpp"
 #include "sim/study/fit.hpp"
 #include "sim/study/sweep.hpp"
@@ -46,7 +45,7 @@ void write_profile_plot(const std::string& path, const FitResult& r) {
   gp << "set grid\nset border 3\nset tics nomirror\nset ylabel '2 (l_max - l_profile)' noenhanced\nset key top center\n";
   for (const FitParamResult& p : r.params) {
     gp << "set xlabel " << gnuplot_quote(p.key) << " noenhanced\n";
-    gp << "set yrange [0:" << number_text(std::max(8.0, 0.0)) << "]\n";
+    gp << "set yrange [0:8]\n";
     gp << "set arrow from " << number_text(p.ci95.lo) << ",0 to " << number_text(p.ci95.lo) << ",3.841 nohead dt 2\n";
     gp << "set arrow from " << number_text(p.ci95.hi) << ",0 to " << number_text(p.ci95.hi) << ",3.841 nohead dt 2\n";
     gp << "$p << EOD\n";
@@ -61,9 +60,9 @@ void write_profile_plot(const std::string& path, const FitResult& r) {
   run_gnuplot(gp.str(), path);
 }
 
-void print_text(const FitResult& r, const FitArgs& a, const std::string& fidelity) {
+void print_text(const FitResult& r, const FitArgs& a) {
   std::printf("dicesim fit: %zu parameter%s, %zu data set%s, fidelity %s, seed %llu\n", r.params.size(),
-              r.params.size() == 1 ? "" : "s", r.data.size(), r.data.size() == 1 ? "" : "s", fidelity.c_str(),
+              r.params.size() == 1 ? "" : "s", r.data.size(), r.data.size() == 1 ? "" : "s", r.fidelity.c_str(),
               static_cast<unsigned long long>(a.seed));
   for (const FitDataResult& d : r.data) {
     std::uint64_t n = 0;
@@ -138,12 +137,11 @@ int run_fit_cmd(const FitArgs& a) {
   opt.cancel = &g_stop;
   const FitResult r = run_fit(params, data, opt);
   bar.finish();
-  const std::string fidelity = to_string(compile(load_scene(data[0].scene, opt.overrides), data[0].scene).fidelity);
   if (!a.plot.empty()) write_profile_plot(a.plot, r);
   if (a.json)
-    std::printf("%s\n", fit_json(r, opt, fidelity).dump().c_str());
+    std::printf("%s\n", fit_json(r, opt).dump().c_str());
   else
-    print_text(r, a, fidelity);
+    print_text(r, a);
   return kExitOk;
 }
 

@@ -11,7 +11,7 @@ nlohmann::json chi2(const ChiSquare& c) {
 }
 }  // namespace
 
-nlohmann::json fit_json(const FitResult& r, const FitOptions& opt, const std::string& fidelity) {
+nlohmann::json fit_json(const FitResult& r, const FitOptions& opt) {
   nlohmann::json params = nlohmann::json::array();
   for (const FitParamResult& p : r.params)
     params.push_back({{"key", p.key},
@@ -40,7 +40,7 @@ nlohmann::json fit_json(const FitResult& r, const FitOptions& opt, const std::st
           {"gof", chi2(r.gof)},
           {"data", data},
           {"loglik", num(r.loglik)},
-          {"fidelity", fidelity},
+          {"fidelity", r.fidelity},
           {"seed", opt.seed},
           {"rounds", rounds},
           {"simulated_tosses", r.simulated_tosses},

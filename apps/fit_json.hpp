@@ -9,6 +9,6 @@ namespace dicesim {
 
 // {"params": [{"key", "estimate", "ci95": [lo, hi], ...}], "fitted": [{"label", "p", ...}],
 //  "gof": {"statistic", "dof", "p_value"}, "simulated_tosses", "elapsed_s", ...}. NaN -> null.
-nlohmann::json fit_json(const FitResult& r, const FitOptions& opt, const std::string& fidelity);
+nlohmann::json fit_json(const FitResult& r, const FitOptions& opt);
 
 }  // namespace dicesim

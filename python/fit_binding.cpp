@@ -4,7 +4,6 @@
 
 #include "apps/fit_json.hpp"
 #include "python/bindings.hpp"
-#include "sim/models/compile.hpp"
 #include "sim/scene/scene_error.hpp"
 #include "sim/study/fit.hpp"
 
@@ -77,10 +76,7 @@ pb::object do_fit(const pb::object& scene, const pb::object& data, const pb::obj
   if (pb::isinstance<pb::dict>(params)) {
     for (const auto& [k, v] : params.cast<pb::dict>()) {
       const auto range = v.cast<std::pair<double, double>>();
-      ps.push_back(parse_fit_param(k.cast<std::string>() + "=" + std::to_string(range.first) + ":" + std::to_string(range.second),
-                                   "dicesim.fit"));
-      ps.back().lo = range.first;  // exactly as given, not as printed
-      ps.back().hi = range.second;
+      ps.push_back({k.cast<std::string>(), range.first, range.second});  // run_fit checks the range
     }
   } else {
     for (const pb::handle p : params) ps.push_back(parse_fit_param(p.cast<std::string>(), "dicesim.fit"));
@@ -96,10 +92,7 @@ pb::object do_fit(const pb::object& scene, const pb::object& data, const pb::obj
   opt.progress = [&monitor](const std::string&, std::uint64_t d, std::uint64_t t) { monitor.report(d, t); };
   FitResult r;
   run_interruptible([&] { r = run_fit(ps, sets, opt); }, monitor, progress);
-  std::vector<std::string> first = sets[0].overrides;
-  first.insert(first.begin(), opt.overrides.begin(), opt.overrides.end());
-  const std::string fid = to_string(compile(load_scene(sets[0].scene, first), sets[0].scene).fidelity);
-  return pb::module_::import("json").attr("loads")(fit_json(r, opt, fid).dump());
+  return pb::module_::import("json").attr("loads")(fit_json(r, opt).dump());
 }
 
 }  // namespace

@@ -9,7 +9,6 @@
 #include <thread>
 
 #include <Eigen/Dense>
-#include <boost/math/distributions/chi_squared.hpp>
 
 #include "sim/models/compile.hpp"
 #include "sim/models/toss.hpp"
@@ -136,22 +135,34 @@ VectorXd pattern_search(const Objective& f, const Box& box, VectorXd x, VectorXd
   return x;
 }
 
-// The maximum over the box: a grid (fine in one dimension, coarse in three), then the compass search.
-VectorXd maximize(const Objective& f, const Box& box, double* fx_out = nullptr) {
+// The grid of g values per dimension over the box (ends included exactly), first dimension fastest.
+std::vector<VectorXd> box_grid(const Box& box, int g) {
   const int d = static_cast<int>(box.lo.size());
-  const int g = d == 1 ? 401 : d == 2 ? 61 : 21;
-  VectorXd best(d), x(d);
-  double fbest = -std::numeric_limits<double>::infinity();
   int total = 1;
   for (int i = 0; i < d; ++i) total *= g;
+  std::vector<VectorXd> pts;
+  pts.reserve(static_cast<std::size_t>(total));
   for (int idx = 0; idx < total; ++idx) {
+    VectorXd x(d);
     int r = idx;
     for (int i = 0; i < d; ++i) {
       const int gi = r % g;
       r /= g;
       const auto ii = static_cast<std::size_t>(i);
-      x[i] = box.lo[ii] + (box.hi[ii] - box.lo[ii]) * gi / (g - 1);
+      x[i] = gi == g - 1 ? box.hi[ii] : box.lo[ii] + (box.hi[ii] - box.lo[ii]) * gi / (g - 1);
     }
+    pts.push_back(std::move(x));
+  }
+  return pts;
+}
+
+// The maximum over the box: a grid (fine in one dimension, coarse in three), then the compass search.
+VectorXd maximize(const Objective& f, const Box& box, double* fx_out = nullptr) {
+  const int d = static_cast<int>(box.lo.size());
+  const int g = d == 1 ? 401 : d == 2 ? 61 : 21;
+  VectorXd best;
+  double fbest = -std::numeric_limits<double>::infinity();
+  for (const VectorXd& x : box_grid(box, g)) {
     const double fx = f(x);
     if (fx > fbest) {
       fbest = fx;
@@ -167,24 +178,6 @@ std::string labels_text(const std::vector<int>& v) {
   std::string s;
   for (std::size_t i = 0; i < v.size(); ++i) s += (i ? "," : "") + std::to_string(v[i]);
   return s;
-}
-
-ChiSquare pearson(const std::vector<std::uint64_t>& n, const std::vector<double>& p, int params_used, double* stat_out) {
-  ChiSquare r;
-  double total = 0.0;
-  for (const auto c : n) total += static_cast<double>(c);
-  int cells = 0;
-  for (std::size_t k = 0; k < n.size(); ++k) {
-    if (!(p[k] > 0.0)) continue;
-    ++cells;
-    const double e = total * p[k], dlt = static_cast<double>(n[k]) - e;
-    r.statistic += dlt * dlt / e;
-  }
-  r.dof = cells - 1 - params_used;
-  if (stat_out) *stat_out = r.statistic;
-  r.p_value = r.dof > 0 ? boost::math::cdf(boost::math::complement(boost::math::chi_squared(r.dof), r.statistic))
-                        : std::numeric_limits<double>::quiet_NaN();
-  return r;
 }
 
 class Fitter {
@@ -204,7 +197,7 @@ class Fitter {
   DieModel model_at(std::size_t s, const VectorXd& theta) const {
     return compile(load_scene(data_[s].scene, overrides_at(s, theta)), data_[s].scene);
   }
-  std::vector<VectorXd> grid(const Box& box) const;
+  std::vector<VectorXd> grid(const Box& box) const { return box_grid(box, fit_grid_points(d_)); }
   // Tosses every model with indices 0..tosses-1 in `batches` batches on the thread pool.
   std::vector<PointCounts> simulate(const std::vector<DieModel>& models, std::uint64_t tosses, const std::string& stage);
   Surrogate fit_surrogate(const Box& box, const std::vector<VectorXd>& design, const std::vector<std::vector<PointCounts>>& counts,
@@ -225,25 +218,6 @@ class Fitter {
   std::uint64_t simulated_ = 0;
   std::uint64_t tosses_ = 0;               // per point in the last round
 };
-
-std::vector<VectorXd> Fitter::grid(const Box& box) const {
-  const int g = fit_grid_points(d_);
-  int total = 1;
-  for (int i = 0; i < d_; ++i) total *= g;
-  std::vector<VectorXd> pts;
-  for (int idx = 0; idx < total; ++idx) {
-    VectorXd x(d_);
-    int r = idx;
-    for (int i = 0; i < d_; ++i) {
-      const int gi = r % g;
-      r /= g;
-      const auto ii = static_cast<std::size_t>(i);
-      x[i] = gi == g - 1 ? box.hi[ii] : box.lo[ii] + (box.hi[ii] - box.lo[ii]) * gi / (g - 1);
-    }
-    pts.push_back(x);
-  }
-  return pts;
-}
 
 std::vector<PointCounts> Fitter::simulate(const std::vector<DieModel>& models, std::uint64_t tosses, const std::string& stage) {
   const int B = opt_.batches;
@@ -380,6 +354,7 @@ FitResult Fitter::run() {
   }
 
   FitResult res;
+  res.fidelity = to_string(models.front().front().fidelity);
   Surrogate sur{Basis(d_, 0), box, {}};
   std::vector<std::vector<PointCounts>> counts;
   VectorXd theta(d_);
@@ -547,7 +522,7 @@ FitResult Fitter::run() {
 
   // The fitted probabilities: simulated at the estimate, with the goodness of fit.
   double stat = 0.0;
-  int cells = 0;
+  int dof = 0;
   for (std::size_t s = 0; s < S; ++s) {
     const std::vector<DieModel> at{model_at(s, theta)};
     const PointCounts pc = simulate(at, tosses_, "fitted")[0];
@@ -566,18 +541,14 @@ FitResult Fitter::run() {
       dr.observed.push_back(static_cast<std::uint64_t>(n_[s][static_cast<Eigen::Index>(k)]));
       dr.fitted.push_back(settled ? static_cast<double>(f[k]) / static_cast<double>(settled) : 0.0);
     }
-    double st = 0.0;
-    dr.gof = pearson(dr.observed, dr.fitted, 0, &st);
-    stat += st;
-    for (const double p : dr.fitted) cells += p > 0.0 ? 1 : 0;
-    cells -= 1;
+    dr.gof = chi2_against(dr.observed, dr.fitted);
+    stat += dr.gof.statistic;
+    dof += dr.gof.dof;
     res.data.push_back(std::move(dr));
   }
   res.gof.statistic = stat;
-  res.gof.dof = cells - d_;
-  res.gof.p_value = res.gof.dof > 0
-                        ? boost::math::cdf(boost::math::complement(boost::math::chi_squared(res.gof.dof), stat))
-                        : std::numeric_limits<double>::quiet_NaN();
+  res.gof.dof = dof - d_;
+  res.gof.p_value = res.gof.dof > 0 ? chi2_p_value(stat, res.gof.dof) : std::numeric_limits<double>::quiet_NaN();
   res.simulated_tosses = simulated_;
   res.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;

@@ -108,6 +108,7 @@ struct FitResult {
   std::vector<FitParamResult> params;
   std::vector<FitDataResult> data;
   ChiSquare gof;  // all data sets together, dof = sum(outcomes - 1) - parameters
+  std::string fidelity;  // the first data set's model's (after --fidelity / sim.fidelity)
   double loglik = 0.0;
   std::uint64_t simulated_tosses = 0;
   double elapsed_s = 0.0;

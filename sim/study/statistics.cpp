@@ -18,7 +18,7 @@ Interval wilson_interval(std::uint64_t successes, std::uint64_t n, double z) {
   return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
 }
 
-static double chi2_p_value(double statistic, int dof) {
+double chi2_p_value(double statistic, int dof) {
   if (dof <= 0) return 1.0;
   boost::math::chi_squared dist(dof);
   return boost::math::cdf(boost::math::complement(dist, statistic));

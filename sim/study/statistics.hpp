@@ -25,6 +25,9 @@ struct ChiSquare {
   double p_value = 1.0;
 };
 
+// P(chi2_dof > statistic); 1 for dof <= 0.
+double chi2_p_value(double statistic, int dof);
+
 // Pearson chi-square of `counts` against equal probabilities.
 ChiSquare chi2_uniform(std::span<const std::uint64_t> counts);
 // Pearson chi-square of `counts` against probabilities `p` (sum 1); cells with p = 0 are skipped.
