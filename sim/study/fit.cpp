@@ -202,6 +202,8 @@ class Fitter {
   std::vector<PointCounts> simulate(const std::vector<DieModel>& models, std::uint64_t tosses, const std::string& stage);
   Surrogate fit_surrogate(const Box& box, const std::vector<VectorXd>& design, const std::vector<std::vector<PointCounts>>& counts,
                           int skip_batch) const;
+  FitParamResult profile_param(int i, const Surrogate& sur, const Box& box, const VectorXd& theta, double lmax,
+                               double mc_sd) const;
   double loglik(const Surrogate& sur, const VectorXd& theta) const {
     double l = 0.0;
     for (std::size_t s = 0; s < data_.size(); ++s) l += n_[s].dot(sur.log_p(s, theta));
@@ -293,6 +295,94 @@ Surrogate Fitter::fit_surrogate(const Box& box, const std::vector<VectorXd>& des
     sur.coef.push_back(fit_log_p(sur.basis, phi, c, n));
   }
   return sur;
+}
+
+// Parameter i's profile over the box (the others maximised, warm-started along it), its 95%
+// interval and the interval widened by the Monte Carlo sd.
+FitParamResult Fitter::profile_param(int i, const Surrogate& sur, const Box& box, const VectorXd& theta, double lmax,
+                                     double mc_sd) const {
+  const auto ii = static_cast<std::size_t>(i);
+  FitParamResult pr;
+  pr.key = params_[ii].key;
+  pr.lo = params_[ii].lo;
+  pr.hi = params_[ii].hi;
+  auto profile_at = [&, i](double t, VectorXd& warm) {
+    if (d_ == 1) {
+      VectorXd x(1);
+      x[0] = t;
+      return loglik(sur, x);
+    }
+    Box sub;
+    std::vector<int> dims;
+    for (int k = 0; k < d_; ++k)
+      if (k != i) {
+        dims.push_back(k);
+        sub.lo.push_back(box.lo[static_cast<std::size_t>(k)]);
+        sub.hi.push_back(box.hi[static_cast<std::size_t>(k)]);
+      }
+    auto g = [&](const VectorXd& y) {
+      VectorXd x(d_);
+      x[i] = t;
+      for (std::size_t k = 0; k < dims.size(); ++k) x[dims[k]] = y[static_cast<Eigen::Index>(k)];
+      return loglik(sur, x);
+    };
+    VectorXd st(static_cast<Eigen::Index>(dims.size()));
+    for (std::size_t k = 0; k < dims.size(); ++k) st[static_cast<Eigen::Index>(k)] = 0.05 * (sub.hi[k] - sub.lo[k]);
+    double fw = 0.0, ft = 0.0;
+    VectorXd from_theta(static_cast<Eigen::Index>(dims.size()));
+    for (std::size_t k = 0; k < dims.size(); ++k) from_theta[static_cast<Eigen::Index>(k)] = theta[dims[k]];
+    VectorXd a = pattern_search(g, sub, warm.size() ? warm : from_theta, st, &fw);
+    VectorXd b2 = pattern_search(g, sub, from_theta, st, &ft);
+    warm = fw >= ft ? a : b2;
+    return std::max(fw, ft);
+  };
+  constexpr int kProfile = 101;
+  const double blo = box.lo[ii], bhi = box.hi[ii];
+  VectorXd warm;
+  // From the estimate outwards on both sides, so the warm start follows the ridge.
+  std::vector<double> grid_t;
+  for (int k = 0; k < kProfile; ++k) grid_t.push_back(k == kProfile - 1 ? bhi : blo + (bhi - blo) * k / (kProfile - 1));
+  std::vector<double> prof(grid_t.size());
+  const auto centre = static_cast<std::size_t>(std::lower_bound(grid_t.begin(), grid_t.end(), theta[i]) - grid_t.begin());
+  for (std::size_t k = centre; k < grid_t.size(); ++k) prof[k] = profile_at(grid_t[k], warm);
+  warm = VectorXd();
+  for (std::size_t k = centre; k-- > 0;) prof[k] = profile_at(grid_t[k], warm);
+  double lbest = lmax;
+  for (const double v : prof) lbest = std::max(lbest, v);
+  for (std::size_t k = 0; k < grid_t.size(); ++k) pr.profile.push_back({grid_t[k], 2.0 * (lbest - prof[k])});
+  // The interval is the hull of the confidence set {t : 2 (l_max - l_profile(t)) < 3.84}: each
+  // end is found from the box's edge inwards (the first grid value inside the set, then
+  // bisection), so a second mode that the data cannot tell from the first stays inside it.
+  auto end_on = [&](int dir, bool& open) {
+    VectorXd w;
+    const long size = static_cast<long>(grid_t.size());
+    auto inside_set = [&](long k) { return 2.0 * (lbest - prof[static_cast<std::size_t>(k)]) < kChi2Level95; };
+    long k = dir < 0 ? 0 : size - 1;
+    if (inside_set(k)) {
+      open = true;
+      return dir < 0 ? blo : bhi;
+    }
+    while (!inside_set(k - dir) && (k - dir) != static_cast<long>(centre)) k -= dir;
+    double out = grid_t[static_cast<std::size_t>(k)], in = grid_t[static_cast<std::size_t>(k - dir)];
+    if (!inside_set(k - dir)) in = theta[i];  // only the estimate's own neighbourhood is inside
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (out + in);
+      (2.0 * (lbest - profile_at(mid, w)) >= kChi2Level95 ? out : in) = mid;
+    }
+    open = false;
+    return 0.5 * (out + in);
+  };
+  bool lo_open = false, hi_open = false;
+  pr.ci95_profile = {end_on(-1, lo_open), end_on(+1, hi_open)};
+  pr.lo_open = lo_open && blo <= params_[ii].lo;
+  pr.hi_open = hi_open && bhi >= params_[ii].hi;
+  pr.estimate = theta[i];
+  pr.mc_sd = mc_sd;
+  const double z = kZ95 * pr.mc_sd;
+  pr.ci95.lo = std::max(params_[ii].lo, pr.estimate - std::hypot(pr.estimate - pr.ci95_profile.lo, z));
+  pr.ci95.hi = std::min(params_[ii].hi, pr.estimate + std::hypot(pr.ci95_profile.hi - pr.estimate, z));
+  pr.mc_large = pr.mc_sd > 0.5 * (pr.ci95_profile.hi - pr.ci95_profile.lo) / (2.0 * kZ95);
+  return pr;
 }
 
 FitResult Fitter::run() {
@@ -388,94 +478,9 @@ FitResult Fitter::run() {
     for (const VectorXd& t : jk) var += (t - mean).cwiseAbs2();
     const VectorXd mc_sd = (var * (static_cast<double>(B - 1) / B)).cwiseSqrt();
 
-    // Profiles: each parameter on a grid over the box, the others maximised (warm-started along it).
-    res.params.assign(static_cast<std::size_t>(d_), {});
-    for (int i = 0; i < d_; ++i) {
-      const auto ii = static_cast<std::size_t>(i);
-      FitParamResult& pr = res.params[ii];
-      pr.key = params_[ii].key;
-      pr.lo = params_[ii].lo;
-      pr.hi = params_[ii].hi;
-      auto profile_at = [&, i](double t, VectorXd& warm) {
-        if (d_ == 1) {
-          VectorXd x(1);
-          x[0] = t;
-          return loglik(sur, x);
-        }
-        Box sub;
-        std::vector<int> dims;
-        for (int k = 0; k < d_; ++k)
-          if (k != i) {
-            dims.push_back(k);
-            sub.lo.push_back(box.lo[static_cast<std::size_t>(k)]);
-            sub.hi.push_back(box.hi[static_cast<std::size_t>(k)]);
-          }
-        auto g = [&](const VectorXd& y) {
-          VectorXd x(d_);
-          x[i] = t;
-          for (std::size_t k = 0; k < dims.size(); ++k) x[dims[k]] = y[static_cast<Eigen::Index>(k)];
-          return loglik(sur, x);
-        };
-        VectorXd st(static_cast<Eigen::Index>(dims.size()));
-        for (std::size_t k = 0; k < dims.size(); ++k) st[static_cast<Eigen::Index>(k)] = 0.05 * (sub.hi[k] - sub.lo[k]);
-        double fw = 0.0, ft = 0.0;
-        VectorXd from_theta(static_cast<Eigen::Index>(dims.size()));
-        for (std::size_t k = 0; k < dims.size(); ++k) from_theta[static_cast<Eigen::Index>(k)] = theta[dims[k]];
-        VectorXd a = pattern_search(g, sub, warm.size() ? warm : from_theta, st, &fw);
-        VectorXd b2 = pattern_search(g, sub, from_theta, st, &ft);
-        warm = fw >= ft ? a : b2;
-        return std::max(fw, ft);
-      };
-      constexpr int kProfile = 101;
-      const double blo = box.lo[ii], bhi = box.hi[ii];
-      std::vector<double> ts, ls;
-      VectorXd warm;
-      // From the estimate outwards on both sides, so the warm start follows the ridge.
-      std::vector<double> grid_t;
-      for (int k = 0; k < kProfile; ++k) grid_t.push_back(k == kProfile - 1 ? bhi : blo + (bhi - blo) * k / (kProfile - 1));
-      std::vector<double> prof(grid_t.size());
-      const auto centre = static_cast<std::size_t>(std::lower_bound(grid_t.begin(), grid_t.end(), theta[i]) - grid_t.begin());
-      warm = VectorXd();
-      for (std::size_t k = centre; k < grid_t.size(); ++k) prof[k] = profile_at(grid_t[k], warm);
-      warm = VectorXd();
-      for (std::size_t k = centre; k-- > 0;) prof[k] = profile_at(grid_t[k], warm);
-      double lbest = lmax;
-      for (const double v : prof) lbest = std::max(lbest, v);
-      for (std::size_t k = 0; k < grid_t.size(); ++k) pr.profile.push_back({grid_t[k], 2.0 * (lbest - prof[k])});
-      // The interval's ends: the first grid value past the cut on each side, then bisection.
-      // The interval is the hull of the confidence set {t : 2 (l_max - l_profile(t)) < 3.84}: each
-      // end is found from the box's edge inwards (the first grid value inside the set, then
-      // bisection), so a second mode that the data cannot tell from the first stays inside it.
-      auto end_on = [&](int dir, bool& open) {
-        VectorXd w;
-        const long size = static_cast<long>(grid_t.size());
-        auto inside_set = [&](long k) { return 2.0 * (lbest - prof[static_cast<std::size_t>(k)]) < kChi2Level95; };
-        long k = dir < 0 ? 0 : size - 1;
-        if (inside_set(k)) {
-          open = true;
-          return dir < 0 ? blo : bhi;
-        }
-        while (!inside_set(k - dir) && (k - dir) != static_cast<long>(centre)) k -= dir;
-        double out = grid_t[static_cast<std::size_t>(k)], in = grid_t[static_cast<std::size_t>(k - dir)];
-        if (!inside_set(k - dir)) in = theta[i];  // only the estimate's own neighbourhood is inside
-        for (int it = 0; it < 60; ++it) {
-          const double mid = 0.5 * (out + in);
-          (2.0 * (lbest - profile_at(mid, w)) >= kChi2Level95 ? out : in) = mid;
-        }
-        open = false;
-        return 0.5 * (out + in);
-      };
-      bool lo_open = false, hi_open = false;
-      pr.ci95_profile = {end_on(-1, lo_open), end_on(+1, hi_open)};
-      pr.lo_open = lo_open && blo <= params_[ii].lo;
-      pr.hi_open = hi_open && bhi >= params_[ii].hi;
-      pr.estimate = theta[i];
-      pr.mc_sd = mc_sd[i];
-      const double z = kZ95 * pr.mc_sd;
-      pr.ci95.lo = std::max(params_[ii].lo, pr.estimate - std::hypot(pr.estimate - pr.ci95_profile.lo, z));
-      pr.ci95.hi = std::min(params_[ii].hi, pr.estimate + std::hypot(pr.ci95_profile.hi - pr.estimate, z));
-      pr.mc_large = pr.mc_sd > 0.5 * (pr.ci95_profile.hi - pr.ci95_profile.lo) / (2.0 * kZ95);
-    }
+    // Profiles: each parameter on a grid over the box, the others maximised.
+    res.params.clear();
+    for (int i = 0; i < d_; ++i) res.params.push_back(profile_param(i, sur, box, theta, lmax, mc_sd[i]));
     FitRound fr;
     fr.box_lo = box.lo;
     fr.box_hi = box.hi;
