@@ -99,7 +99,7 @@ void register_worker(CLI::App& app, int& exit_code) {
                   "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0, which never leaves this host)")
       ->type_name("URL");
   cmd->add_option("--run", args->run, "Serve only the run with this id (dicesim run uses it)")->type_name("ID");
-  cmd->add_flag("--once", args->once, "Exit after the first run served ends");
+  cmd->add_flag("--once", args->once, "Exit after the first run it served ends (one that leased it work, or that it heard finish; a run that fell silent without leasing it anything does not count)");
   cmd->add_option("--batch", args->batch, "Tosses per published batch")
       ->capture_default_str()
       ->check(CLI::Range(1, wire::kMaxBatch));

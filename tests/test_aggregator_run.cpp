@@ -260,6 +260,28 @@ TEST(AggregatorRun, ForeignAndMalformedBatchesAreCountedAndIgnored) {
   EXPECT_EQ(net.agg->result(), f.reference(2000));
 }
 
+// A run_start that nobody leases from (another run's, forged, or an aggregator that died at once)
+// does not count as a served run: `dicesim worker --once` must not exit after it. CI once saw both
+// workers of the hostile scenario hear the injector's foreign run_start first, wait out its
+// silence and exit, leaving the real run without workers.
+TEST(AggregatorRun, ARunThatNeverLeasedTheWorkerIsNotAServedRun) {
+  Fixture f(1000);
+  Net net = make_net(f, 1);
+  wire::RunSpec foreign = f.cfg.spec;
+  foreign.run_id = f.cfg.spec.run_id + 1;
+  foreign.total = 5;
+  const auto m = wire::encode(wire::to_message(foreign));
+  net.workers[0]->on_message(wire::kRunStart, m.data(), m.size(), 0.0);
+  ASSERT_EQ(net.workers[0]->run_id(), foreign.run_id);
+  while (net.workers[0]->run_id() != f.cfg.spec.run_id && net.steps < 2000) net.step();
+  ASSERT_EQ(net.workers[0]->run_id(), f.cfg.spec.run_id) << "the silent run ends and the real one is taken up";
+  EXPECT_EQ(net.workers[0]->runs_served(), 0) << "the foreign run leased nothing: not served";
+  ASSERT_TRUE(net.run());
+  for (int i = 0; i < 10; ++i) net.step();  // the final probabilities reach the worker
+  EXPECT_EQ(net.workers[0]->runs_served(), 1);
+  EXPECT_EQ(net.agg->result().faces, f.reference(1000).faces);
+}
+
 TEST(AggregatorRun, WorkerRefusesAModelItCannotRebuild) {
   Fixture f(1000);
   f.cfg.spec.fingerprint ^= 1;  // as if the aggregator ran another build

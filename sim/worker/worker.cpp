@@ -68,7 +68,10 @@ void WorkerCore::on_message(std::string_view channel, const void* data, std::siz
     if (auto m = wire::decode<dicesim_lcm::work_lease>(data, len)) return on_lease(*m, now);
   } else if (channel == wire::kProbabilities) {
     if (auto m = wire::decode<dicesim_lcm::probabilities>(data, len)) {
-      if (run_ && m->run_id == run_->spec.run_id && m->finished == 1) end_run("finished");
+      if (run_ && m->run_id == run_->spec.run_id && m->finished == 1) {
+        run_->finished = true;
+        end_run("finished");
+      }
       return;
     }
   }
@@ -167,10 +170,11 @@ void WorkerCore::end_run(const char* why, bool final) {
     cfg_.log("run " + std::to_string(run_->spec.run_id) + " ended: " + why + " (" + std::to_string(tosses_done_) +
              " tosses by this worker)");
   if (final) ended_runs_.insert(run_->spec.run_id);
+  // Finished with its aggregator, or leased work: served. Otherwise only heard of.
+  if (run_->finished || last_lease_seen_ > 0) ++runs_served_;
   run_.reset();
   if (cfg_.on_run) cfg_.on_run(0);
   leases_.clear();
-  ++runs_finished_;
 }
 
 void WorkerCore::send_status(double now) {
@@ -334,7 +338,7 @@ int run_worker(const WorkerOptions& opt) {
     }
     const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     core.tick(now);
-    if (opt.once && core.runs_finished() > 0) break;
+    if (opt.once && core.runs_served() > 0) break;
     if (!core.step(now)) bus.handleTimeout(50);
   }
   if (opt.core.log && core.unauthenticated() > 0)

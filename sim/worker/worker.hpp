@@ -60,7 +60,10 @@ class WorkerCore {
 
   std::int64_t id() const { return cfg_.worker_id; }
   std::int64_t run_id() const { return run_ ? run_->spec.run_id : 0; }
-  int runs_finished() const { return runs_finished_; }
+  // Runs this worker served that have ended: it was leased work, or it heard the run finish. A run
+  // that went silent without ever leasing it anything (an abandoned or foreign run_start) was not
+  // served, so `--once` goes on listening after it.
+  int runs_served() const { return runs_served_; }
   std::uint64_t tosses_done() const { return tosses_done_; }
   std::uint64_t ignored() const { return ignored_; }  // undecodable or inapplicable messages
   std::uint64_t unauthenticated() const { return unauthenticated_; }  // with a key: failed the HMAC check
@@ -71,6 +74,7 @@ class WorkerCore {
     std::optional<DieModel> model;  // empty: refused (error says why)
     std::string error;
     double last_heard = 0.0;
+    bool finished = false;  // its aggregator said so
   };
   struct Lease {
     std::int64_t id;
@@ -99,7 +103,7 @@ class WorkerCore {
   std::uint64_t tosses_done_ = 0, ignored_ = 0, traces_skipped_ = 0, unauthenticated_ = 0;
   wire::Sealer sealer_;
   bool told_key_ = false;  // logged once that sealed / unsealed runs were heard
-  int runs_finished_ = 0;
+  int runs_served_ = 0;
   int batch_now_ = 0;                    // the next batch's size (batch_s at the measured speed)
   double last_step_ = -1.0;              // when the previous batch began (its size: last_n_)
   std::uint64_t last_n_ = 0;
@@ -116,7 +120,7 @@ struct WorkerOptions {
   // Both set: serve this run from the start (WorkerCore::adopt), without waiting for its run_start.
   const wire::RunSpec* known_spec = nullptr;
   const DieModel* known_model = nullptr;
-  bool once = false;                          // exit after the first run it served ends
+  bool once = false;                          // exit after the first run it served ends (runs_served)
   const std::atomic<bool>* cancel = nullptr;  // set from a signal handler
 };
 

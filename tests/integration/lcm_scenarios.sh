@@ -121,6 +121,10 @@ case "$scenario" in
     n=200000
     reference
     worker; worker
+    # Both in the real run before the injector's foreign run_start (else they may take that one
+    # up first: they would go on listening after its silence, but the scenario is about hostile
+    # messages reaching a running system).
+    listening 2
     aggregate & agg=$!
     "$inject" hostile > "$work/inject.out" || fail "inject failed"
     wait "$agg" || fail "aggregate exited $?"
