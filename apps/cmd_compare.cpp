@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
+#include "apps/report.hpp"
 #include "sim/study/compare.hpp"
 #include "sim/scene/scene_error.hpp"
 
@@ -36,7 +37,7 @@ int run_compare(const CompareArgs& a) {
                        {"diff", f.diff}, {"ci95", {f.ci95.lo, f.ci95.hi}},
                        {"differs", f.ci95.lo > 0.0 || f.ci95.hi < 0.0}});
     const nlohmann::json j = {{"a", a.a}, {"b", a.b}, {"n_a", c.n_a}, {"n_b", c.n_b},
-                              {"chi2", {{"statistic", c.chi2.statistic}, {"dof", c.chi2.dof}, {"p_value", c.chi2.p_value}}},
+                              {"chi2", chi2_json(c.chi2)},
                               {"min_expected", c.min_expected}, {"alpha", a.alpha}, {"differ", differ}, {"faces", faces}};
     std::printf("%s\n", j.dump().c_str());
     return kExitOk;

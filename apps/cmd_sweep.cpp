@@ -180,7 +180,7 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
     if (m.found) {
       p["seed"] = {{"p", m.p}};
       if (spec.seed_tosses > 0) {
-        p["seed"]["chi2"] = {{"statistic", m.chi2.statistic}, {"dof", m.chi2.dof}, {"p_value", m.chi2.p_value}};
+        p["seed"]["chi2"] = chi2_json(m.chi2);
         ++compared;
         if (m.chi2.p_value < 0.01) ++rejected;
       }

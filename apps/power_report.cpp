@@ -4,13 +4,14 @@
 #include <cstdarg>
 #include <cstdio>
 
+#include "apps/report.hpp"
+
 namespace dicesim {
 namespace {
 
 using nlohmann::json;
 
 json opt(const std::optional<std::uint64_t>& n) { return n ? json(*n) : json(nullptr); }
-json finite_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
 
 json intervals(const std::vector<Interval>& ci) {
   json a = json::array();
@@ -20,7 +21,7 @@ json intervals(const std::vector<Interval>& ci) {
 
 json exact_json(const ExactN& e) {
   return {{"n", opt(e.n)},          {"power", e.at.power},           {"size", e.at.size},
-          {"critical", finite_or_null(e.at.critical)}, {"evaluations", e.evaluations}};
+          {"critical", json_number(e.at.critical)}, {"evaluations", e.evaluations}};
 }
 
 json common(const PowerRunInfo& info, const std::vector<int>& labels, const SimulatedDie& a, int dof,
@@ -101,7 +102,7 @@ json power_json(const PowerRunInfo& info, const AgainstStudy& s) {
   j["settled_b"] = s.b.counts.settled;
   j["p_b"] = s.b.p;
   j["p_b_ci95"] = intervals(s.b.ci95);
-  j["w2"] = finite_or_null(s.w2);
+  j["w2"] = json_number(s.w2);
   j["difference"] = {{"statistic", s.difference.statistic},
                      {"dof", s.difference.dof},
                      {"p_value", s.difference.p_value},
@@ -120,7 +121,7 @@ json power_json(const PowerRunInfo& info, const BiasStudy& s) {
     alts.push_back({{"face", a.label},
                     {"sign", a.sign},
                     {"p_face", a.p[a.face]},
-                    {"w2", finite_or_null(a.w2)},
+                    {"w2", json_number(a.w2)},
                     {"n_approx", opt(a.n_approx)},
                     {"n_exact", opt(a.exact.n)},
                     {"power_at_n", a.exact.at.power}});

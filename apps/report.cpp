@@ -1,6 +1,7 @@
 #include "apps/report.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
@@ -59,6 +60,12 @@ std::string corrections_line(const RunCorrections& k) {
   return line;
 }
 
+nlohmann::json json_number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json chi2_json(const ChiSquare& c) {
+  return {{"statistic", json_number(c.statistic)}, {"dof", c.dof}, {"p_value", json_number(c.p_value)}};
+}
+
 nlohmann::json report_json(const RunReport& r) {
   nlohmann::json faces = nlohmann::json::array();
   for (const FaceRow& f : face_rows(r))
@@ -73,7 +80,7 @@ nlohmann::json report_json(const RunReport& r) {
           {"unresolved", r.counts.unresolved},
           {"invalid", r.counts.invalid},
           {"faces", faces},
-          {"chi2_uniform", {{"statistic", chi.statistic}, {"dof", chi.dof}, {"p_value", chi.p_value}}},
+          {"chi2_uniform", chi2_json(chi)},
           {"bounces_per_toss", r.tosses ? static_cast<double>(r.counts.bounces) / static_cast<double>(r.tosses) : 0.0},
           {"corrections", corrections_json(r.counts.corrections)},
           {"elapsed_s", r.elapsed_s},

@@ -9,6 +9,7 @@
 
 #include "sim/body/die_model.hpp"
 #include "sim/study/monte_carlo.hpp"
+#include "sim/study/statistics.hpp"
 
 namespace dicesim {
 
@@ -31,6 +32,10 @@ struct RunReport {
 //  intervals over settled tosses, faces by label (N outcomes; chi-square on N - 1 dof against every
 //  face equally likely, grouped labels weighted by their faces).
 nlohmann::json report_json(const RunReport& r);
+// A number, or null when it is not finite (JSON has no NaN or infinity; Python then sees None).
+nlohmann::json json_number(double v);
+// {"statistic", "dof", "p_value"}: every command's chi-square test, written one way.
+nlohmann::json chi2_json(const ChiSquare& c);
 // {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks"}: the run's totals (toss, run, sweep points).
 nlohmann::json corrections_json(const RunCorrections& k);
 // "corrections: N energy clamps, ... (each should be 0: the physics was repaired)", or "" when all are 0.
