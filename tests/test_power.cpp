@@ -212,6 +212,30 @@ TEST(Power, SearchFindsTheCrossingAndIsReproducible) {
   EXPECT_FALSE(approx_n(p0, p0, 0.05, 0.8).has_value());
 }
 
+TEST(Power, ExactNHasTheWantedPowerOnFreshDraws) {
+  // The whole procedure, checked from outside: at the n the search returns, throws drawn afresh
+  // (another seed, 10x the replicates) from p1 reject H0 (at the search's critical value) with
+  // the wanted power. The tolerance is 4 sd of the search's estimate and of the fresh fraction.
+  const std::vector<double> p0(6, 1.0 / 6), p1 = {0.19, 0.16, 0.16, 0.16, 0.16, 0.17};
+  PowerTarget t;
+  t.seed = 31;
+  const auto start = approx_n(p0, p1, t.alpha, t.power);
+  ASSERT_TRUE(start.has_value());
+  const ExactN e = exact_n(p0, p1, t, *start);
+  ASSERT_TRUE(e.n.has_value());
+  const int fresh = 10 * static_cast<int>(t.replicates);
+  int rejected = 0;
+  std::vector<std::uint64_t> c(p0.size());
+  for (int r = 0; r < fresh; ++r) {
+    CountStream rng(777, static_cast<std::uint64_t>(r), CountStream::kAlternative);
+    sample_multinomial(*e.n, p1, rng, c);
+    rejected += pearson_statistic(c, p0) > e.at.critical ? 1 : 0;
+  }
+  const double power = static_cast<double>(rejected) / fresh;
+  const double sd = std::sqrt(0.8 * 0.2 * (1.0 / fresh + 1.0 / static_cast<double>(t.replicates)));
+  EXPECT_NEAR(power, 0.8, 4 * sd) << "n = " << *e.n;
+}
+
 TEST(Power, ZeroCellsUnderH0) {
   // p0 rules a face out: one such throw rejects, so n is where one occurs with the wanted power.
   const std::vector<double> p0 = {0.5, 0.5, 0.0}, p1 = {0.45, 0.45, 0.1};
