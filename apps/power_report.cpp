@@ -127,7 +127,8 @@ json power_json(const PowerRunInfo& info, const BiasStudy& s) {
                     {"power_at_n", a.exact.at.power}});
   j["alternatives"] = alts;
   const BiasAlternative& h = s.alternatives.at(s.hardest);
-  j["hardest"] = {{"face", h.label}, {"sign", h.sign}};
+  // n_exact_selecting: the search that made it the hardest; n_exact above is its fresh search.
+  j["hardest"] = {{"face", h.label}, {"sign", h.sign}, {"n_exact_selecting", opt(h.exact.n)}, {"refreshed", s.refreshed}};
   return j;
 }
 
@@ -168,6 +169,10 @@ std::string power_table(const PowerRunInfo& info, const BiasStudy& s) {
     }
   }
   const BiasAlternative& h = s.alternatives.at(s.hardest);
+  if (s.refreshed && s.estimate.exact.n)
+    t += format("the hardest searched again on %llu fresh replicates (a maximum over searches is biased up): n exact %llu\n",
+                static_cast<unsigned long long>(info.config.target.replicates),
+                static_cast<unsigned long long>(*s.estimate.exact.n));
   return t + verdict(info, s.estimate, s.dof,
                      format(" against every alternative (hardest: face %d moved by %c%g)", h.label, h.sign > 0 ? '+' : '-',
                             s.delta)

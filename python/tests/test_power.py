@@ -31,7 +31,9 @@ def test_power_detect_bias(dicesim):
     assert d["mode"] == "detect_bias" and d["detect_bias"] == 0.05
     assert len(d["alternatives"]) == 12
     worst = max(a["n_exact"] for a in d["alternatives"])
-    assert d["n_exact"] == worst
+    # The hardest was picked by its search and searched again on fresh replicates for n_exact.
+    assert d["hardest"]["n_exact_selecting"] == worst and d["hardest"]["refreshed"]
+    assert abs(d["n_exact"] - worst) < 0.2 * worst
 
 
 def test_power_bad_input(dicesim, die1):

@@ -284,7 +284,7 @@ PowerAtN simulated_power(std::span<const double> p0, std::span<const double> p1,
   std::vector<std::uint64_t> counts(k);
   std::vector<double> null_stats(reps);
   for (std::uint64_t r = 0; r < reps; ++r) {
-    CountStream rng(target.seed, r, CountStream::kNull);
+    CountStream rng(target.seed, target.first_replicate + r, CountStream::kNull);
     sample_multinomial(n, p0, rng, counts);
     null_stats[r] = pearson_statistic(counts, p0);
   }
@@ -299,7 +299,7 @@ PowerAtN simulated_power(std::span<const double> p0, std::span<const double> p1,
   at.size = static_cast<double>(above_null) / static_cast<double>(reps);
   std::uint64_t above = 0;
   for (std::uint64_t r = 0; r < reps; ++r) {
-    CountStream rng(target.seed, r, CountStream::kAlternative);
+    CountStream rng(target.seed, target.first_replicate + r, CountStream::kAlternative);
     sample_multinomial(n, p1, rng, counts);
     above += pearson_statistic(counts, p0) > at.critical ? 1 : 0;
   }
@@ -583,7 +583,15 @@ BiasStudy power_detect_bias(const DieModel& a, double delta, const PowerStudyCon
   const BiasAlternative& h = s.alternatives[s.hardest];
   s.estimate.n_approx = h.n_approx;
   s.estimate.exact = h.exact;
-  s.estimate.replicate_sd = replicate_sd(s.a.p, h.p, h.exact, cfg.target);
+  if (na > 1 && h.exact.n && !cancelled(cfg)) {
+    // The largest of several noisy searches overstates the n it picked (by up to about one
+    // replicate sd when alternatives are alike): that one is searched again on fresh replicates.
+    PowerTarget fresh = cfg.target;
+    fresh.first_replicate = cfg.target.replicates;
+    s.estimate.exact = exact_n(s.a.p, h.p, fresh, *h.exact.n, cfg.cancel);
+    s.refreshed = true;
+  }
+  s.estimate.replicate_sd = replicate_sd(s.a.p, h.p, s.estimate.exact, cfg.target);
 
   // Bootstrap of the largest approximate n over the alternatives (rebuilt on each resample).
   auto worst_approx = [&](std::span<const double> p) {

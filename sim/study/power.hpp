@@ -72,6 +72,9 @@ struct PowerTarget {
   double power = 0.8;                 // wanted power, in (alpha, 1)
   std::uint64_t replicates = 4000;    // simulated count vectors per hypothesis and n
   std::uint64_t seed = 1;             // of the count draws
+  // Replicate r draws from counter first_replicate + r: another first_replicate (e.g. R) gives
+  // draws independent of the default ones under the same seed.
+  std::uint64_t first_replicate = 0;
 };
 
 // The largest n considered: beyond it n is reported as not reached.
@@ -176,7 +179,10 @@ struct BiasStudy {
   int dof = 0;
   std::vector<BiasAlternative> alternatives;  // skipped signs (p' outside [0, 1]) left out
   std::size_t hardest = 0;                    // index into alternatives: the largest exact n
-  PowerEstimate estimate;                     // n = the hardest alternative's, with its range
+  // n = the hardest alternative's, with its range. With several alternatives its exact n is
+  // searched again on fresh replicates (refreshed), since the maximum of noisy searches is biased up.
+  PowerEstimate estimate;
+  bool refreshed = false;
   std::uint64_t simulated_tosses = 0;
   bool cancelled = false;
 };
@@ -185,7 +191,8 @@ struct BiasStudy {
 // (a sign leaving [0, 1], or a face with p = 1, is skipped).
 std::vector<BiasAlternative> bias_alternatives(std::span<const double> p, double delta, const std::vector<int>& labels);
 
-// Every alternative's exact n is searched (on cfg.threads threads, each alone reproducible).
+// Every alternative's exact n is searched (on cfg.threads threads, each alone reproducible); the
+// hardest one's again on replicates R..2R-1, for the estimate.
 BiasStudy power_detect_bias(const DieModel& a, double delta, const PowerStudyConfig& cfg);
 
 }  // namespace dicesim
