@@ -81,7 +81,11 @@ int replay_run(const ReplayArgs& a) {
   r.threads = std::max(1, res.workers);
   r.tosses = res.tosses;
   r.counts = res.counts;
-  r.labels.assign(res.labels.begin(), res.labels.end());
+  // The live report's labels and fair-die expectation, from the same model when it is the run's.
+  if (res.model_matches && res.model.outcome_labels == res.labels)
+    set_labels(r, res.model);
+  else
+    r.labels.assign(res.labels.begin(), res.labels.end());
   r.elapsed_s = elapsed;
   print_report(r, a.json);
   return kExitOk;

@@ -201,6 +201,7 @@ ReplayResult replay(const ReplayOptions& opt) {
   res.spec = rb.spec;
   res.labels = rb.spec.labels;
   res.model_matches = rb.matches;
+  res.model = rb.model;
   logging::set_run_id(rb.spec.run_id);
   spdlog::info("replaying run {}: {} ({}), seed {}, {} tosses", rb.spec.run_id, rb.spec.origin, rb.spec.fidelity,
                rb.spec.seed, rb.spec.total);

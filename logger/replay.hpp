@@ -39,6 +39,7 @@ struct ReplayResult {
   wire::RunSpec spec;                // from run_start
   std::vector<int> labels;           // the run's outcome labels (run_start's), counts in this order
   bool model_matches = true;         // the model rebuilt here has the run's fingerprint
+  DieModel model;                    // that model (its faces per label, a coin's heads and tails)
   RunCounts counts;                  // over toss indices [0, tosses)
   std::uint64_t tosses = 0;
   agg::Health health;                // what the aggregator ignored, and why

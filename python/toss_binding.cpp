@@ -298,6 +298,10 @@ void register_toss(pb::module_& m) {
           "chi2_uniform", [](Result& r) { return r.field("chi2_uniform"); },
           "Pearson chi-square against a fair die: {'statistic', 'dof', 'p_value'}.")
       .def_property_readonly(
+          "chi2_heads_tails", [](Result& r) { return r.field("chi2_heads_tails"); },
+          "A coin's heads against tails, edge landings left out (1 dof): {'statistic', 'dof', 'p_value'};\n"
+          "None for a die.")
+      .def_property_readonly(
           "elapsed_s", [](const Result& r) { return r.report().elapsed_s; }, "Wall-clock time of the run (s).")
       .def_property_readonly(
           "tosses", [](const Result& r) { return r.report().tosses; }, "Tosses made (with a target: where it stopped).")

@@ -45,6 +45,28 @@ TEST(Cli, TossJsonIsOneObjectWithEveryKey) {
   EXPECT_TRUE(j["chi2_uniform"].contains("p_value"));
 }
 
+// A coin is fair when heads and tails are equally likely: that test leaves its edge landings out
+// (1 dof), beside the uniform one over heads, tails and edge. A die has no such test (null).
+TEST(Cli, ACoinIsTestedHeadsAgainstTails) {
+  const CliRun r = cli("toss scenes/coins/quarter.toml --tosses 2000 --seed 3 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  double heads = -1, tails = -1, edge = -1;
+  for (const auto& f : j["faces"]) {  // the quarter's labels: heads 1, tails 2, edge 0
+    const int label = f["face"];
+    (label == 1 ? heads : label == 2 ? tails : edge) = f["count"].get<double>();
+  }
+  ASSERT_GT(edge, 0.0) << "the test must have edge landings to leave out";
+  const auto& c = j["chi2_heads_tails"];
+  EXPECT_EQ(c["dof"], 1);
+  EXPECT_NEAR(c["statistic"].get<double>(), (heads - tails) * (heads - tails) / (heads + tails), 1e-9);
+  EXPECT_EQ(j["chi2_uniform"]["dof"], 2);
+  const CliRun table = cli("toss scenes/coins/quarter.toml --tosses 2000 --seed 3");
+  EXPECT_NE(table.out.find("chi-square vs a fair coin (heads = tails, edge landings left out)"), std::string::npos) << table.out;
+  const CliRun die = cli("toss scenes/paper/die1.toml --tosses 1000 --json");
+  EXPECT_TRUE(nlohmann::json::parse(die.out)["chi2_heads_tails"].is_null());
+}
+
 TEST(Cli, CountsDoNotDependOnThreads) {
   const auto counts = [](const std::string& threads) {
     const CliRun r = cli("toss scenes/paper/die2.toml --tosses 5000 --seed 9 --json --threads " + threads);

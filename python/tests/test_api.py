@@ -73,6 +73,7 @@ def test_result_arrays(dicesim, die1):
     d = r.to_dict()
     assert [f["count"] for f in d["faces"]] == list(r.counts)
     assert r.chi2_uniform == d["chi2_uniform"]
+    assert r.chi2_heads_tails is None  # a die
     assert r.corrections == d.get("corrections")  # None until the report has a corrections object
     assert "face" in str(r) and "settled" in repr(r)
 
@@ -144,3 +145,11 @@ def test_stub_names_exist(dicesim):
                      "Sweep", "SceneError"}
     for name in names:
         assert hasattr(dicesim, name), name
+
+
+def test_a_coin_is_tested_heads_against_tails(dicesim):
+    r = dicesim.toss(dicesim.load_scene("scenes/coins/quarter.toml"), 2000, seed=3)
+    c = r.chi2_heads_tails
+    assert c == r.to_dict()["chi2_heads_tails"] and c["dof"] == 1
+    n = dict(zip(r.labels, r.counts))  # heads 1, tails 2, edge 0
+    assert abs(c["statistic"] - (n[1] - n[2]) ** 2 / (n[1] + n[2])) < 1e-9

@@ -23,6 +23,8 @@ n=150000
 case "$scenario" in
   *_d20) scene=scenes/dice/d20.toml; scenario=${scenario%_d20} ;;
   *_d4) scene=scenes/dice/d4.toml; scenario=${scenario%_d4} ;;
+  # A coin: the replayed report must also carry the live one's heads-against-tails test.
+  *_coin) scene=scenes/coins/quarter.toml; scenario=${scenario%_coin} ;;
 esac
 echo "scenario $scenario on $scene"
 
