@@ -6,6 +6,7 @@
 #include <optional>
 #include <vector>
 
+#include "sim/scene/scene.hpp"
 #include "sim/study/statistics.hpp"
 
 namespace dicesim {
@@ -13,6 +14,7 @@ namespace {
 
 struct FaceRow {
   int label;
+  std::string name;  // a coin's side; empty for a die
   std::uint64_t count;
   double p;
   Interval ci;
@@ -23,7 +25,7 @@ std::vector<FaceRow> face_rows(const RunReport& r) {
   for (std::size_t i = 0; i < r.counts.faces.size() && i < r.labels.size(); ++i) {
     const std::uint64_t c = r.counts.faces[i];
     const double p = r.counts.settled ? static_cast<double>(c) / static_cast<double>(r.counts.settled) : 0.0;
-    rows.push_back({r.labels[i], c, p, wilson_interval(c, r.counts.settled)});
+    rows.push_back({r.labels[i], i < r.names.size() ? r.names[i] : "", c, p, wilson_interval(c, r.counts.settled)});
   }
   std::sort(rows.begin(), rows.end(), [](const FaceRow& a, const FaceRow& b) { return a.label < b.label; });
   return rows;
@@ -77,8 +79,10 @@ nlohmann::json chi2_json(const ChiSquare& c) {
 
 nlohmann::json report_json(const RunReport& r) {
   nlohmann::json faces = nlohmann::json::array();
-  for (const FaceRow& f : face_rows(r))
+  for (const FaceRow& f : face_rows(r)) {
     faces.push_back({{"face", f.label}, {"count", f.count}, {"p", f.p}, {"ci95", {f.ci.lo, f.ci.hi}}});
+    if (!f.name.empty()) faces.back()["name"] = f.name;
+  }
   const ChiSquare chi = chi2_fair(r);
   const auto coin = chi2_heads_tails(r);
   return {{"scene", r.scene},
@@ -107,8 +111,8 @@ std::string report_table(const RunReport& r) {
   out += line;
   out += "face       count        p     95% interval (Wilson)\n";
   for (const FaceRow& f : face_rows(r)) {
-    std::snprintf(line, sizeof line, "%4d  %10llu   %.5f   [%.5f, %.5f]\n", f.label,
-                  static_cast<unsigned long long>(f.count), f.p, f.ci.lo, f.ci.hi);
+    std::snprintf(line, sizeof line, "%4d  %10llu   %.5f   [%.5f, %.5f]%s%s\n", f.label,
+                  static_cast<unsigned long long>(f.count), f.p, f.ci.lo, f.ci.hi, f.name.empty() ? "" : "   ", f.name.c_str());
     out += line;
   }
   std::snprintf(line, sizeof line, "\nsettled %llu, unresolved %llu, invalid %llu (p and intervals over settled tosses)\n",
@@ -138,9 +142,18 @@ void set_labels(RunReport& r, const DieModel& m) {
   r.faces_per_label.assign(m.outcome_labels.size(), 0);
   for (const int k : m.face_outcome) ++r.faces_per_label[static_cast<std::size_t>(k)];
   r.heads = r.tails = -1;
+  r.names.clear();
+  if (!m.curved()) return;
   // A cylinder's faces are heads, tails and the edge, in that order (kCylinderOutcomeNames).
-  if (m.curved() && m.face_outcome.size() >= 2 && m.face_outcome[0] != m.face_outcome[1])
-    r.heads = m.face_outcome[0], r.tails = m.face_outcome[1];
+  r.names.assign(m.outcome_labels.size(), "");
+  for (std::size_t f = 0; f < m.face_outcome.size() && f < kCylinderOutcomeNames.size(); ++f) {
+    std::string& name = r.names[static_cast<std::size_t>(m.face_outcome[f])];
+    if (!name.empty()) name += '/';
+    name += kCylinderOutcomeNames[f];
+  }
+  // Heads against tails needs both alone in their outcomes (not grouped together or with the edge).
+  const auto& o = m.face_outcome;
+  if (o.size() == 3 && o[0] != o[1] && o[0] != o[2] && o[1] != o[2]) r.heads = o[0], r.tails = o[1];
 }
 
 void print_report(const RunReport& r, bool json) {

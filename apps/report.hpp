@@ -24,11 +24,14 @@ struct RunReport {
   std::vector<int> faces_per_label; // faces showing each label (empty: one each); a fair die's expectation
   // A coin (cylinder): the outcome indices of heads and tails (-1: not a coin, or both one label).
   int heads = -1, tails = -1;
+  // Per outcome (counts.faces order), a coin's side names: "heads", "tails", "edge" ("heads/tails"
+  // when labels group them). Empty for a die.
+  std::vector<std::string> names;
   double elapsed_s = 0.0;
 };
 
 // {"scene", "fidelity", "seed", "threads", "tosses", "settled", "unresolved", "invalid",
-//  "faces": [{"face", "count", "p", "ci95": [lo, hi]}], "chi2_uniform": {"statistic", "dof", "p_value"},
+//  "faces": [{"face", "count", "p", "ci95": [lo, hi]} (a coin's also "name": heads, tails, edge)], "chi2_uniform": {"statistic", "dof", "p_value"},
 //  "chi2_heads_tails": a coin's heads against tails, edge landings left out (1 dof; null for a die),
 //  "corrections": {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks"} (totals over
 //  the run; the table prints a line only when one is non-zero), "elapsed_s", "tosses_per_s"} -- p and

@@ -46,7 +46,8 @@ TEST(Cli, TossJsonIsOneObjectWithEveryKey) {
 }
 
 // A coin is fair when heads and tails are equally likely: that test leaves its edge landings out
-// (1 dof), beside the uniform one over heads, tails and edge. A die has no such test (null).
+// (1 dof), beside the uniform one over heads, tails and edge. A die has no such test (null). A
+// coin's outcomes are named.
 TEST(Cli, ACoinIsTestedHeadsAgainstTails) {
   const CliRun r = cli("toss scenes/coins/quarter.toml --tosses 2000 --seed 3 --json");
   ASSERT_EQ(r.code, 0) << r.err;
@@ -55,6 +56,7 @@ TEST(Cli, ACoinIsTestedHeadsAgainstTails) {
   for (const auto& f : j["faces"]) {  // the quarter's labels: heads 1, tails 2, edge 0
     const int label = f["face"];
     (label == 1 ? heads : label == 2 ? tails : edge) = f["count"].get<double>();
+    EXPECT_EQ(f["name"], label == 1 ? "heads" : label == 2 ? "tails" : "edge");
   }
   ASSERT_GT(edge, 0.0) << "the test must have edge landings to leave out";
   const auto& c = j["chi2_heads_tails"];
@@ -63,8 +65,14 @@ TEST(Cli, ACoinIsTestedHeadsAgainstTails) {
   EXPECT_EQ(j["chi2_uniform"]["dof"], 2);
   const CliRun table = cli("toss scenes/coins/quarter.toml --tosses 2000 --seed 3");
   EXPECT_NE(table.out.find("chi-square vs a fair coin (heads = tails, edge landings left out)"), std::string::npos) << table.out;
-  const CliRun die = cli("toss scenes/paper/die1.toml --tosses 1000 --json");
-  EXPECT_TRUE(nlohmann::json::parse(die.out)["chi2_heads_tails"].is_null());
+  EXPECT_NE(table.out.find("   heads\n"), std::string::npos) << table.out;
+  // Edge landings counted as heads: no heads-against-tails test, and the grouped side is named so.
+  const auto grouped = nlohmann::json::parse(cli("toss scenes/coins/quarter.toml --tosses 500 --json --set die.faces.edge=1").out);
+  EXPECT_TRUE(grouped["chi2_heads_tails"].is_null());
+  EXPECT_EQ(grouped["faces"][0]["name"], "heads/edge");
+  const auto die = nlohmann::json::parse(cli("toss scenes/paper/die1.toml --tosses 1000 --json").out);
+  EXPECT_TRUE(die["chi2_heads_tails"].is_null());
+  EXPECT_FALSE(die["faces"][0].contains("name"));
 }
 
 TEST(Cli, CountsDoNotDependOnThreads) {
