@@ -93,8 +93,9 @@ void print_text(const FitResult& r, const FitArgs& a) {
                 static_cast<unsigned long long>(d.fitted_tosses));
     std::printf("%8s %10s %10s %10s\n", "outcome", "observed", "expected", "p fitted");
     for (std::size_t k = 0; k < d.labels.size(); ++k)
-      std::printf("%8d %10llu %10.1f %10.4f\n", d.labels[k], static_cast<unsigned long long>(d.observed[k]),
-                  d.fitted[k] * static_cast<double>(n), d.fitted[k]);
+      std::printf("%8d %10llu %10.1f %10.4f%s%s\n", d.labels[k], static_cast<unsigned long long>(d.observed[k]),
+                  d.fitted[k] * static_cast<double>(n), d.fitted[k], k < d.names.size() ? "   " : "",
+                  k < d.names.size() ? d.names[k].c_str() : "");
     std::printf("chi-square %.2f on %d dof, p = %.3g\n", d.gof.statistic, d.gof.dof, d.gof.p_value);
   }
   if (r.gof.dof > 0)

@@ -20,8 +20,10 @@ nlohmann::json fit_json(const FitResult& r, const FitOptions& opt) {
   nlohmann::json fitted = nlohmann::json::array(), data = nlohmann::json::array();
   for (std::size_t s = 0; s < r.data.size(); ++s) {
     const FitDataResult& d = r.data[s];
-    for (std::size_t k = 0; k < d.labels.size(); ++k)
+    for (std::size_t k = 0; k < d.labels.size(); ++k) {
       fitted.push_back({{"label", d.labels[k]}, {"p", json_number(d.fitted[k])}, {"observed", d.observed[k]}, {"data", s}});
+      if (k < d.names.size()) fitted.back()["name"] = d.names[k];  // a coin's side
+    }
     data.push_back({{"scene", d.scene}, {"counts", d.source}, {"fitted_tosses", d.fitted_tosses}, {"gof", chi2_json(d.gof)}});
   }
   nlohmann::json rounds = nlohmann::json::array();

@@ -6,7 +6,7 @@
 #include <optional>
 #include <vector>
 
-#include "sim/scene/scene.hpp"
+#include "sim/body/outcome.hpp"
 #include "sim/study/statistics.hpp"
 
 namespace dicesim {
@@ -142,16 +142,10 @@ void set_labels(RunReport& r, const DieModel& m) {
   r.faces_per_label.assign(m.outcome_labels.size(), 0);
   for (const int k : m.face_outcome) ++r.faces_per_label[static_cast<std::size_t>(k)];
   r.heads = r.tails = -1;
-  r.names.clear();
+  r.names = outcome_names(m);
   if (!m.curved()) return;
-  // A cylinder's faces are heads, tails and the edge, in that order (kCylinderOutcomeNames).
-  r.names.assign(m.outcome_labels.size(), "");
-  for (std::size_t f = 0; f < m.face_outcome.size() && f < kCylinderOutcomeNames.size(); ++f) {
-    std::string& name = r.names[static_cast<std::size_t>(m.face_outcome[f])];
-    if (!name.empty()) name += '/';
-    name += kCylinderOutcomeNames[f];
-  }
-  // Heads against tails needs both alone in their outcomes (not grouped together or with the edge).
+  // A cylinder's faces are heads, tails and the edge, in that order (kCylinderOutcomeNames). Heads
+  // against tails needs both alone in their outcomes (not grouped together or with the edge).
   const auto& o = m.face_outcome;
   if (o.size() == 3 && o[0] != o[1] && o[0] != o[2] && o[1] != o[2]) r.heads = o[0], r.tails = o[1];
 }

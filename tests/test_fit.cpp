@@ -225,6 +225,26 @@ TEST(CliFit, JsonHasTheDocumentedFields) {
   EXPECT_TRUE(j["elapsed_s"].is_number());
 }
 
+// A coin's outcomes are named; with two outcomes and one key no degree of freedom is left, so no
+// goodness of fit is claimed (p null, and the table says why).
+TEST(CliFit, ACoinsSidesAreNamedAndNoFreedomIsSaidSo) {
+  const std::string data = testing::unique_temp("coin.csv");
+  std::ofstream(data) << "face,count\n1,5080\n2,4920\n";
+  const std::string args = "fit scenes/coins/quarter-caught.toml --data " + data + " --param throw.spin.tilt_deg=80:89 -n 4000";
+  const CliRun r = testing::run_dicesim(args + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["fitted"].size(), 3u);
+  EXPECT_EQ(j["fitted"][0]["name"], "edge");
+  EXPECT_EQ(j["fitted"][1]["name"], "heads");
+  EXPECT_EQ(j["fitted"][2]["name"], "tails");
+  EXPECT_EQ(j["gof"]["dof"], 0);
+  EXPECT_TRUE(j["gof"]["p_value"].is_null());
+  const CliRun t = testing::run_dicesim(args);
+  EXPECT_NE(t.out.find("none possible, 1 fitted key for 1 free outcome frequency"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("   heads\n"), std::string::npos) << t.out;
+}
+
 TEST(CliFit, BadInputExitsTwoAndNamesIt) {
   const std::string data = testing::unique_temp("counts.csv");
   std::ofstream(data) << "face,count\n1,80\n2,83\n7,84\n";

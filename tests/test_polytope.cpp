@@ -192,8 +192,10 @@ TEST(Polytope, LoadedD20FavoursTheFaceOppositeItsSlab) {
     const int up = m.face_result[heavy];
     const RunCounts r = run(m, f == Fidelity::Static ? 40000 : 3000, 4);
     const std::uint64_t fav = r.faces[static_cast<std::size_t>(m.face_outcome[static_cast<std::size_t>(up)])];
-    for (std::size_t k = 0; k < r.faces.size(); ++k)
-      if (k != static_cast<std::size_t>(m.face_outcome[static_cast<std::size_t>(up)])) EXPECT_GT(fav, r.faces[k]) << to_string(f);
+    for (std::size_t k = 0; k < r.faces.size(); ++k) {
+      if (k == static_cast<std::size_t>(m.face_outcome[static_cast<std::size_t>(up)])) continue;
+      EXPECT_GT(fav, r.faces[k]) << to_string(f);
+    }
     // Above the fair 1/20 (Wilson 99.9% lower bound).
     EXPECT_GT(wilson_interval(fav, r.settled, 3.29).lo, 1.0 / 20.0) << to_string(f);
   }
@@ -302,8 +304,10 @@ TEST(Polytope, ReadyScenesInStatic) {
   const std::size_t two = static_cast<std::size_t>(
       std::find(m.outcome_labels.begin(), m.outcome_labels.end(), 2) - m.outcome_labels.begin());
   ASSERT_LT(two, r.faces.size());
-  for (std::size_t k = 0; k < r.faces.size(); ++k)
-    if (k != two) EXPECT_GT(r.faces[two], r.faces[k]) << "label " << m.outcome_labels[k];
+  for (std::size_t k = 0; k < r.faces.size(); ++k) {
+    if (k == two) continue;
+    EXPECT_GT(r.faces[two], r.faces[k]) << "label " << m.outcome_labels[k];
+  }
   EXPECT_GT(wilson_interval(r.faces[two], r.settled, 3.29).lo, 1.0 / 20.0);
 }
 

@@ -2,6 +2,9 @@
 // from below such as a d4, most nearly down), and the outcome (label) it shows.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "sim/body/die_model.hpp"
 
 namespace dicesim {
@@ -33,6 +36,20 @@ inline int read_face_index(const DieModel& m, const Mat3& R) {
 inline int caught_face_index(const DieModel& m, const Mat3& R) {
   if (m.curved()) return R.row(2).dot(m.rims.axis) >= 0.0 ? 0 : 1;
   return read_face_index(m, R);
+}
+
+// Per outcome (outcome_labels order), a coin's side names: "heads", "tails", "edge", joined by "/"
+// when labels group them. Empty for a die (its outcomes are its face labels).
+inline std::vector<std::string> outcome_names(const DieModel& m) {
+  std::vector<std::string> names;
+  if (!m.curved()) return names;
+  names.assign(m.outcome_labels.size(), "");
+  for (std::size_t f = 0; f < m.face_outcome.size() && f < kCylinderOutcomeNames.size(); ++f) {
+    std::string& name = names[static_cast<std::size_t>(m.face_outcome[f])];
+    if (!name.empty()) name += '/';
+    name += kCylinderOutcomeNames[f];
+  }
+  return names;
 }
 
 }  // namespace dicesim

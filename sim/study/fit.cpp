@@ -10,6 +10,7 @@
 
 #include <Eigen/Dense>
 
+#include "sim/body/outcome.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/models/toss.hpp"
 #include "sim/scene/scene.hpp"
@@ -535,6 +536,7 @@ FitResult Fitter::run() {
     dr.scene = data_[s].scene;
     dr.source = data_[s].source;
     dr.labels = labels_[s];
+    if (at[0].outcome_labels == dr.labels) dr.names = outcome_names(at[0]);
     dr.fitted_tosses = tosses_;
     std::uint64_t settled = 0;
     std::vector<std::uint64_t> f(labels_[s].size(), 0);

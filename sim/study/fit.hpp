@@ -92,6 +92,7 @@ struct FitParamResult {
 struct FitDataResult {
   std::string scene, source;
   std::vector<int> labels;              // the die's outcomes, ascending
+  std::vector<std::string> names;       // a coin's side per label (outcome_names); empty for a die
   std::vector<std::uint64_t> observed;  // per label
   std::vector<double> fitted;           // simulated at the estimate, per label
   std::uint64_t fitted_tosses = 0;
