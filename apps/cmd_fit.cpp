@@ -101,11 +101,12 @@ void print_text(const FitResult& r, const FitArgs& a) {
   if (r.gof.dof > 0)
     std::printf("\ngoodness of fit (all data, %zu fitted): chi-square %.2f on %d dof, p = %.3g\n", r.params.size(),
                 r.gof.statistic, r.gof.dof, r.gof.p_value);
-  else  // e.g. a coin's heads and tails, one key: the fit can match them exactly
+  else {  // e.g. a coin's heads and tails, one key: the fit can match them exactly
+    const std::size_t keys = r.params.size();
+    const int free = r.gof.dof + static_cast<int>(keys);
     std::printf("\ngoodness of fit (all data): none possible, %zu fitted key%s for %d free outcome frequenc%s "
-                "(chi-square %.2f)\n", r.params.size(), r.params.size() == 1 ? "" : "s",
-                r.gof.dof + static_cast<int>(r.params.size()), r.gof.dof + static_cast<int>(r.params.size()) == 1 ? "y" : "ies",
-                r.gof.statistic);
+                "(chi-square %.2f)\n", keys, keys == 1 ? "" : "s", free, free == 1 ? "y" : "ies", r.gof.statistic);
+  }
   std::printf("%zu rounds, %llu tosses simulated in %.1f s (95%% interval: profile likelihood of the surrogate, widened\n"
               "by the Monte Carlo sd in quadrature; ideal: the Fisher information's, for comparison)\n",
               r.rounds.size(), static_cast<unsigned long long>(r.simulated_tosses), r.elapsed_s);

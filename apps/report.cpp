@@ -43,9 +43,13 @@ ChiSquare chi2_fair(const RunReport& r) {
 
 // A fair coin: heads and tails equally likely. Its edge landings are a matter of thickness, not of
 // fairness, so they are left out (uniform over heads, tails and edge is no coin's expectation).
+// Needs heads and tails each alone in its outcome: a grouped side ("heads/edge") has no test.
 std::optional<ChiSquare> chi2_heads_tails(const RunReport& r) {
-  if (r.heads < 0 || r.tails < 0) return std::nullopt;
-  const std::uint64_t two[2] = {r.counts.faces[static_cast<std::size_t>(r.heads)], r.counts.faces[static_cast<std::size_t>(r.tails)]};
+  const auto heads = std::find(r.names.begin(), r.names.end(), "heads");
+  const auto tails = std::find(r.names.begin(), r.names.end(), "tails");
+  if (heads == r.names.end() || tails == r.names.end() || r.names.size() != r.counts.faces.size()) return std::nullopt;
+  const std::uint64_t two[2] = {r.counts.faces[static_cast<std::size_t>(heads - r.names.begin())],
+                                r.counts.faces[static_cast<std::size_t>(tails - r.names.begin())]};
   return chi2_uniform(two);
 }
 
@@ -120,17 +124,13 @@ std::string report_table(const RunReport& r) {
                 static_cast<unsigned long long>(r.counts.invalid));
   out += line;
   out += corrections_line(r.counts.corrections);
-  const ChiSquare chi = chi2_fair(r);
-  if (const auto coin = chi2_heads_tails(r)) {
-    std::snprintf(line, sizeof line, "chi-square vs a fair coin (heads = tails, edge landings left out): %.2f on %d dof, p = %.3g\n",
-                  coin->statistic, coin->dof, coin->p_value);
+  auto chi_line = [&](const char* against, const ChiSquare& c) {
+    std::snprintf(line, sizeof line, "chi-square vs %s: %.2f on %d dof, p = %.3g\n", against, c.statistic, c.dof, c.p_value);
     out += line;
-    std::snprintf(line, sizeof line, "chi-square vs heads, tails and edge equally likely: %.2f on %d dof, p = %.3g\n",
-                  chi.statistic, chi.dof, chi.p_value);
-  } else {
-    std::snprintf(line, sizeof line, "chi-square vs a fair die: %.2f on %d dof, p = %.3g\n", chi.statistic, chi.dof, chi.p_value);
-  }
-  out += line;
+  };
+  const auto coin = chi2_heads_tails(r);
+  if (coin) chi_line("a fair coin (heads = tails, edge landings left out)", *coin);
+  chi_line(coin ? "heads, tails and edge equally likely" : "a fair die", chi2_fair(r));
   std::snprintf(line, sizeof line, "%.3f s, %.0f tosses/s, %.2f impacts per toss\n", r.elapsed_s, rate(r),
                 r.tosses ? static_cast<double>(r.counts.bounces) / static_cast<double>(r.tosses) : 0.0);
   out += line;
@@ -141,13 +141,7 @@ void set_labels(RunReport& r, const DieModel& m) {
   r.labels = m.outcome_labels;
   r.faces_per_label.assign(m.outcome_labels.size(), 0);
   for (const int k : m.face_outcome) ++r.faces_per_label[static_cast<std::size_t>(k)];
-  r.heads = r.tails = -1;
   r.names = outcome_names(m);
-  if (!m.curved()) return;
-  // A cylinder's faces are heads, tails and the edge, in that order (kCylinderOutcomeNames). Heads
-  // against tails needs both alone in their outcomes (not grouped together or with the edge).
-  const auto& o = m.face_outcome;
-  if (o.size() == 3 && o[0] != o[1] && o[0] != o[2] && o[1] != o[2]) r.heads = o[0], r.tails = o[1];
 }
 
 void print_report(const RunReport& r, bool json) {

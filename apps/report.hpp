@@ -22,8 +22,6 @@ struct RunReport {
   RunCounts counts;
   std::vector<int> labels;          // label of each counts.faces entry (the model's outcome_labels)
   std::vector<int> faces_per_label; // faces showing each label (empty: one each); a fair die's expectation
-  // A coin (cylinder): the outcome indices of heads and tails (-1: not a coin, or both one label).
-  int heads = -1, tails = -1;
   // Per outcome (counts.faces order), a coin's side names: "heads", "tails", "edge" ("heads/tails"
   // when labels group them). Empty for a die.
   std::vector<std::string> names;

@@ -68,10 +68,7 @@ void WorkerCore::on_message(std::string_view channel, const void* data, std::siz
     if (auto m = wire::decode<dicesim_lcm::work_lease>(data, len)) return on_lease(*m, now);
   } else if (channel == wire::kProbabilities) {
     if (auto m = wire::decode<dicesim_lcm::probabilities>(data, len)) {
-      if (run_ && m->run_id == run_->spec.run_id && m->finished == 1) {
-        run_->finished = true;
-        end_run("finished");
-      }
+      if (run_ && m->run_id == run_->spec.run_id && m->finished == 1) end_run(RunEnd::Finished);
       return;
     }
   }
@@ -89,13 +86,13 @@ void WorkerCore::on_run_start(const dicesim_lcm::run_start& m, double now) {
     return;
   }
   if (run_ && now - run_->last_heard < cfg_.run_silence_s) return;  // busy with another live run
-  if (run_) end_run("replaced by a newer run");
+  if (run_) end_run(RunEnd::Replaced);
   start_run(wire::from_message(m), nullptr, now);
 }
 
 void WorkerCore::adopt(const wire::RunSpec& spec, const DieModel& model, double now) {
   if (spec.run_id == 0 || (cfg_.only_run != 0 && spec.run_id != cfg_.only_run) || ended_runs_.count(spec.run_id)) return;
-  if (run_) end_run("replaced by a newer run");
+  if (run_) end_run(RunEnd::Replaced);
   start_run(spec, &model, now);
 }
 
@@ -164,14 +161,17 @@ void WorkerCore::on_lease(const dicesim_lcm::work_lease& m, double now) {
   last_lease_seen_ = std::max(last_lease_seen_, m.lease_id);
 }
 
-void WorkerCore::end_run(const char* why, bool final) {
+void WorkerCore::end_run(RunEnd how) {
   if (!run_) return;
+  const char* why = how == RunEnd::Finished   ? "finished"
+                    : how == RunEnd::Replaced ? "replaced by a newer run"
+                                              : "no run_start heard for a while";
   if (cfg_.log)
     cfg_.log("run " + std::to_string(run_->spec.run_id) + " ended: " + why + " (" + std::to_string(tosses_done_) +
              " tosses by this worker)");
-  if (final) ended_runs_.insert(run_->spec.run_id);
+  if (how != RunEnd::Silent) ended_runs_.insert(run_->spec.run_id);
   // Finished with its aggregator, or leased work: served. Otherwise only heard of.
-  if (run_->finished || last_lease_seen_ > 0) ++runs_served_;
+  if (how == RunEnd::Finished || last_lease_seen_ > 0) ++runs_served_;
   run_.reset();
   if (cfg_.on_run) cfg_.on_run(0);
   leases_.clear();
@@ -197,7 +197,7 @@ void WorkerCore::send_status(double now) {
 }
 
 void WorkerCore::tick(double now) {
-  if (run_ && now - run_->last_heard > cfg_.run_silence_s) end_run("no run_start heard for a while", false);
+  if (run_ && now - run_->last_heard > cfg_.run_silence_s) end_run(RunEnd::Silent);
   if (now - rate_t_ >= 1.0) {
     rate_ = static_cast<double>(tosses_done_ - rate_n_) / (now - rate_t_);
     rate_t_ = now;

@@ -74,7 +74,6 @@ class WorkerCore {
     std::optional<DieModel> model;  // empty: refused (error says why)
     std::string error;
     double last_heard = 0.0;
-    bool finished = false;  // its aggregator said so
   };
   struct Lease {
     std::int64_t id;
@@ -87,9 +86,10 @@ class WorkerCore {
   void on_lease(const dicesim_lcm::work_lease& m, double now);
   // Every batch of the lease is out: drop it and tell the aggregator.
   void finish_lease(std::deque<Lease>::iterator it, double now);
-  // `final`: the run is over for good (finished, replaced); otherwise (its aggregator went
-  // silent) the same run may be served again when its run_start comes back (a resumed aggregator).
-  void end_run(const char* why, bool final = true);
+  // Finished or Replaced: the run is over for good. Silent (its aggregator went quiet): the same
+  // run may be served again when its run_start comes back (a resumed aggregator).
+  enum class RunEnd { Finished, Replaced, Silent };
+  void end_run(RunEnd how);
   void send(const char* channel, std::vector<std::uint8_t> bytes);
   void send_status(double now);
   void trace(std::uint64_t index, double now);
