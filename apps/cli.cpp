@@ -4,6 +4,7 @@
 
 #include "aggregator/checkpoint.hpp"
 #include "apps/commands.hpp"
+#include "apps/provenance.hpp"
 #include "messages/auth.hpp"
 #include "sim/scene/scene_error.hpp"
 
@@ -20,11 +21,13 @@ void SceneArgs::add_to(CLI::App* cmd) {
       ->type_name("F");
 }
 
-SceneDef SceneArgs::load() const {
+std::vector<std::string> SceneArgs::applied_overrides() const {
   std::vector<std::string> all = overrides;
   if (!fidelity.empty()) all.push_back("sim.fidelity=\"" + fidelity + "\"");
-  return load_scene(path, all);
+  return all;
 }
+
+SceneDef SceneArgs::load() const { return load_scene(path, applied_overrides()); }
 
 CLI::Option* add_key_file_option(CLI::App* cmd, std::string& path) {
   return cmd->add_option("--key-file", path,
@@ -46,6 +49,8 @@ int parse_and_run(CLI::App& app, int argc, char** argv, const int& exit_code) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "%s: %s\nRun with --help for usage.\n", app.get_name().c_str(), e.what());
@@ -97,6 +102,8 @@ int run_cli(int argc, char** argv) {
   register_watch(app, exit_code);
   register_record(app, exit_code);
   register_replay(app, exit_code);
+  register_version(app, exit_code);
+  app.set_version_flag("--version", std::string("dicesim ") + git_describe(), "Print the version and exit (dicesim version: the build)");
   return parse_and_run(app, argc, argv, exit_code);
 }
 

@@ -19,6 +19,7 @@
 #include "apps/report.hpp"
 #include "logger/log.hpp"
 #include "messages/run_spec.hpp"
+#include "messages/spec_scene.hpp"
 #include "messages/wire.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/models/compile.hpp"
@@ -206,6 +207,7 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   r.counts = res.counts;
   set_labels(r, model);
   r.elapsed_s = res.run_elapsed_s;
+  r.provenance = make_provenance(spec.origin, spec.overrides, wire::spec_scene_sha256(spec), model, spec.seed, spec.total, r.threads);
   print_report(r, a.json);
   return kExitOk;
 }

@@ -94,6 +94,8 @@ nlohmann::json report_json(const RunReport& r) {
           {"seed", r.seed},
           {"threads", r.threads},
           {"tosses", r.tosses},
+          {"partial", r.partial},
+          {"tosses_requested", r.partial ? r.provenance.tosses : r.tosses},
           {"settled", r.counts.settled},
           {"unresolved", r.counts.unresolved},
           {"invalid", r.counts.invalid},
@@ -103,16 +105,25 @@ nlohmann::json report_json(const RunReport& r) {
           {"bounces_per_toss", r.tosses ? static_cast<double>(r.counts.bounces) / static_cast<double>(r.tosses) : 0.0},
           {"corrections", corrections_json(r.counts.corrections)},
           {"elapsed_s", r.elapsed_s},
-          {"tosses_per_s", rate(r)}};
+          {"tosses_per_s", rate(r)},
+          {"provenance", provenance_json(r.provenance)}};
 }
 
 std::string report_table(const RunReport& r) {
   std::string out;
   char line[320];
-  std::snprintf(line, sizeof line, "%s  (fidelity %s, seed %llu, %llu tosses, %d thread%s)\n\n", r.scene.c_str(),
+  std::snprintf(line, sizeof line, "%s  (fidelity %s, seed %llu, %llu tosses, %d thread%s)\n", r.scene.c_str(),
                 r.fidelity.c_str(), static_cast<unsigned long long>(r.seed), static_cast<unsigned long long>(r.tosses),
                 r.threads, r.threads == 1 ? "" : "s");
   out += line;
+  out += provenance_lines(r.provenance);
+  if (r.partial) {
+    std::snprintf(line, sizeof line, "interrupted after %llu of %llu tosses (a complete prefix: the same counts as -n %llu)\n",
+                  static_cast<unsigned long long>(r.tosses), static_cast<unsigned long long>(r.provenance.tosses),
+                  static_cast<unsigned long long>(r.tosses));
+    out += line;
+  }
+  out += "\n";
   out += "face       count        p     95% interval (Wilson)\n";
   for (const FaceRow& f : face_rows(r)) {
     std::snprintf(line, sizeof line, "%4d  %10llu   %.5f   [%.5f, %.5f]%s%s\n", f.label,

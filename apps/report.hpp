@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "apps/provenance.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/study/monte_carlo.hpp"
 #include "sim/study/statistics.hpp"
@@ -26,6 +27,10 @@ struct RunReport {
   // when labels group them). Empty for a die.
   std::vector<std::string> names;
   double elapsed_s = 0.0;
+  Provenance provenance;  // what made it ("provenance" in JSON, the header's lines in the table)
+  // Interrupted (SIGINT/SIGTERM): `tosses` is the longest complete prefix 0..tosses-1 of the
+  // `provenance.tosses` asked for, so the partial counts equal a fresh run of `tosses` tosses.
+  bool partial = false;
 };
 
 // {"scene", "fidelity", "seed", "threads", "tosses", "settled", "unresolved", "invalid",
@@ -33,7 +38,8 @@ struct RunReport {
 //  "chi2_heads_tails": a coin's heads against tails, edge landings left out (1 dof; null for a die),
 //  "corrections": {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks"} (totals over
 //  the run; the table prints a line only when one is non-zero), "elapsed_s", "tosses_per_s"} -- p and
-//  intervals over settled tosses, faces by label (N outcomes; chi-square on N - 1 dof against every
+//  intervals over settled tosses; "partial": true when interrupted (then "tosses" is the complete
+//  prefix run, "tosses_requested" what was asked), "tosses_requested", "provenance" (provenance.hpp); faces by label (N outcomes; chi-square on N - 1 dof against every
 //  face equally likely, grouped labels weighted by their faces).
 nlohmann::json report_json(const RunReport& r);
 // A number, or null when it is not finite (JSON has no NaN or infinity; Python then sees None).

@@ -52,6 +52,13 @@ pb::object do_power(Scene& scene, const std::shared_ptr<Scene>& against, std::op
   }
   info.seed = seed;
   info.threads = resolve_threads(threads);
+  {
+    const std::vector<std::string> extra = fidelity_override(fidelity);
+    std::vector<std::string> overrides = scene.overrides();
+    overrides.insert(overrides.end(), extra.begin(), extra.end());
+    info.provenance = make_provenance(scene.origin(), overrides, scene.sha256_with(extra), *model, seed, n, info.threads);
+    if (against) info.against_sha256 = against->sha256_with(extra);
+  }
   PowerStudyConfig& cfg = info.config;
   cfg.tosses = n;
   cfg.seed = seed;

@@ -4,6 +4,7 @@
 
 #include <pybind11/stl.h>
 
+#include "sim/scene/scene_hash.hpp"
 #include "apps/info_json.hpp"
 #include "python/bindings.hpp"
 #include "sim/models/compile.hpp"
@@ -80,6 +81,12 @@ std::shared_ptr<Scene> Scene::from_text(std::string text, std::string origin, st
   s->def_ = parse_scene(*s->text_, s->origin_, s->overrides_);
   s->model_ = std::make_shared<const DieModel>(compile(s->def_, s->origin_));
   return s;
+}
+
+std::string Scene::sha256_with(const std::vector<std::string>& extra) const {
+  std::vector<std::string> all = overrides_;
+  all.insert(all.end(), extra.begin(), extra.end());
+  return text_ ? scene_text_sha256(*text_, origin_, all) : scene_sha256(origin_, all);
 }
 
 SceneDef Scene::load_with(const std::vector<std::string>& extra) const {

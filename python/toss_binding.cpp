@@ -78,9 +78,14 @@ class Result {
   std::optional<nlohmann::json> json_;
 };
 
+// `extra`: the overrides after the scene's own (fidelity=, a sweep point's key): with them the
+// scene is loaded again for its provenance (the resolved scene's hash), as the CLI reports it.
 RunReport make_report(const Scene& scene, const DieModel& model, std::uint64_t seed, int threads, std::uint64_t tosses,
-                      const RunCounts& counts, double elapsed_s) {
+                      const RunCounts& counts, double elapsed_s, const std::vector<std::string>& extra) {
   RunReport r;
+  std::vector<std::string> overrides = scene.overrides();
+  overrides.insert(overrides.end(), extra.begin(), extra.end());
+  r.provenance = make_provenance(scene.origin(), overrides, scene.sha256_with(extra), model, seed, tosses, threads);
   r.scene = scene.origin();
   r.fidelity = to_string(model.fidelity);
   r.seed = seed;
@@ -163,7 +168,9 @@ Result do_toss(Scene& scene, std::optional<std::uint64_t> n, std::uint64_t seed,
         monitor, progress);
   }
   const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
-  return Result(make_report(scene, *model, seed, nthreads, done, counts, elapsed));
+  RunReport rep = make_report(scene, *model, seed, nthreads, done, counts, elapsed, fidelity_override(fidelity));
+  rep.provenance.tosses = tosses;  // asked for (with a target: the cap), as the CLI's
+  return Result(std::move(rep));
 }
 
 // A sweep: one Result per value, every point tossed with the same seed and indices 0..n-1.
@@ -222,7 +229,8 @@ Sweep run_points(Scene& scene, Sweep out, std::uint64_t n, std::uint64_t seed, i
       monitor, progress);
   out.elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
   for (std::size_t i = 0; i < models.size(); ++i)
-    out.points.push_back(std::make_shared<Result>(make_report(scene, models[i], seed, nthreads, n, counts[i], elapsed[i])));
+    out.points.push_back(
+        std::make_shared<Result>(make_report(scene, models[i], seed, nthreads, n, counts[i], elapsed[i], out.overrides[i])));
   return out;
 }
 

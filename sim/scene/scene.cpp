@@ -18,6 +18,7 @@
 #include <toml++/toml.h>
 
 #include "sim/scene/scene_error.hpp"
+#include "sim/scene/scene_hash.hpp"
 
 namespace dicesim {
 namespace {
@@ -776,6 +777,13 @@ std::string stem_or(const std::string& path, const std::string& fallback) {
   return stem.empty() ? fallback : stem;
 }
 
+// The resolved tree's hash (scene_hash.hpp); build() validates it and reads a mesh's OBJ.
+std::string tree_sha256(toml::table tree, const std::string& origin, const std::vector<std::string>& overrides) {
+  for (const std::string& o : overrides) apply_override(tree, o, origin);
+  const SceneDef def = build(tree, origin, stem_or(origin, "scene"));
+  return sha256_hex(canonical_scene_text(tree, def.die.mesh_text));
+}
+
 SceneDef finish_tree(toml::table tree, const std::string& origin, const std::vector<std::string>& overrides) {
   for (const std::string& o : overrides) apply_override(tree, o, origin);
   return build(tree, origin, stem_or(origin, "scene"));
@@ -795,6 +803,17 @@ SceneDef parse_scene(const std::string& toml_text, const std::string& origin, co
   std::vector<ChainLink> chain;
   toml::table tree = resolve_extends(parse_toml(toml_text, origin), origin, fs::current_path(), chain);
   return finish_tree(std::move(tree), origin, overrides);
+}
+
+std::string scene_sha256(const std::string& path, const std::vector<std::string>& overrides) {
+  std::vector<ChainLink> chain;
+  if (fs::is_regular_file(path)) chain.push_back({fs::weakly_canonical(path), fs::path(path)});
+  return tree_sha256(load_tree(path, chain), path, overrides);
+}
+
+std::string scene_text_sha256(const std::string& toml_text, const std::string& origin, const std::vector<std::string>& overrides) {
+  std::vector<ChainLink> chain;
+  return tree_sha256(resolve_extends(parse_toml(toml_text, origin), origin, fs::current_path(), chain), origin, overrides);
 }
 
 }  // namespace dicesim

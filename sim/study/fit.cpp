@@ -446,6 +446,7 @@ FitResult Fitter::run() {
 
   FitResult res;
   res.fidelity = to_string(models.front().front().fidelity);
+  res.fidelity_reason = models.front().front().fidelity_reason;
   Surrogate sur{Basis(d_, 0), box, {}};
   std::vector<std::vector<PointCounts>> counts;
   VectorXd theta(d_);

@@ -1,4 +1,5 @@
 #include "sim/models/compile.hpp"
+#include "sim/scene/scene_hash.hpp"
 #include "sim/study/sweep.hpp"
 
 #include "sim/body/outcome.hpp"
@@ -335,11 +336,13 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
   // Every point is loaded and compiled before the first toss: a bad value fails at once.
   std::vector<DieModel> models;
   std::vector<std::vector<std::string>> overrides;
+  std::vector<std::string> hashes;
   models.reserve(spec.points.size());
   for (const SweepPoint& p : spec.points) {
     std::vector<std::string> all = spec.overrides;
     all.insert(all.end(), p.overrides.begin(), p.overrides.end());
     models.push_back(compile(load_scene(spec.scene, all), spec.scene));
+    hashes.push_back(scene_sha256(spec.scene, all));
     // One table: the same outcomes at every point (a sweep of die.sides is a sweep per die).
     const std::vector<int>& labels = models.back().outcome_labels;
     auto text = [](const std::vector<int>& v) {
@@ -381,10 +384,18 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
         cfg.progress = [&opt, before, total](std::uint64_t done, std::uint64_t) { opt.progress(before + done, total); };
       r.counts = run_tosses(models[i], cfg);
     }
-    if (opt.cancel && opt.cancel->load()) break;  // a cancelled point is incomplete: not reported
+    const bool cancelled = opt.cancel && opt.cancel->load();
+    // A cancelled point is kept when its counts are a complete prefix (run_tosses in this process)
+    // and not empty; a distributed point's partial counts are not a prefix: dropped.
+    const bool complete = r.counts.total() >= spec.tosses;
+    if (cancelled && !complete && (opt.run_point || r.counts.total() == 0)) break;
+    r.partial = !complete;
     r.labels = models[i].outcome_labels;
     r.fidelity = to_string(models[i].fidelity);
+    r.fidelity_reason = models[i].fidelity_reason;
+    r.scene_sha256 = hashes[i];
     out.points.push_back(std::move(r));
+    if (cancelled) break;
     if (opt.progress) opt.progress(before + spec.tosses, total);
   }
   out.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

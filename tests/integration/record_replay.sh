@@ -29,7 +29,7 @@ esac
 echo "scenario $scenario on $scene"
 
 fail() { echo "FAIL [$scenario]: $*" >&2; for f in "$work"/*.err; do echo "--- $f" >&2; tail -n 20 "$f" >&2; done; exit 1; }
-stable() { sed -E 's/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//; s/"tosses_per_s":[^,}]*,?//' "$1"; }
+stable() { sed -E 's/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//g; s/"tosses_per_s":[^,}]*,?//' "$1"; }
 same_json() {  # same_json A B what
   [ -s "$1" ] || fail "$3: no JSON in $1"
   if [ "$(stable "$1")" != "$(stable "$2")" ]; then
