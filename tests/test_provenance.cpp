@@ -135,7 +135,16 @@ TEST(Provenance, UnwritableOutputPathsFailBeforeWork) {
                    {"--plot", "/nonexistent-dir/f.svg"});
 }
 
-// Runs `dicesim ARGS` from the source tree, sends SIGINT after `wait`, and returns its exit code and stdout.
+// True once `pid` catches SIGINT (its handler is installed: /proc/PID/status, SigCgt).
+bool catches_sigint(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("SigCgt:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> (SIGINT - 1)) & 1u;
+  return false;
+}
+
+// Runs `dicesim ARGS` from the source tree, sends SIGINT `wait` after it started catching it (a
+// loaded machine may take seconds to get there), and returns its exit code and stdout.
 CliRun interrupt_after(const std::string& args, std::chrono::milliseconds wait) {
   int out[2];
   EXPECT_EQ(pipe(out), 0);
@@ -150,6 +159,8 @@ CliRun interrupt_after(const std::string& args, std::chrono::milliseconds wait) 
     _exit(127);
   }
   close(out[1]);
+  for (int i = 0; i < 1200 && !catches_sigint(pid); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_TRUE(catches_sigint(pid)) << "no SIGINT handler after 60 s";
   std::this_thread::sleep_for(wait);
   kill(pid, SIGINT);
   CliRun r;
