@@ -2,6 +2,7 @@
 // statistically different? Chi-square homogeneity test and per-face differences with intervals.
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <stdexcept>
 
@@ -21,6 +22,22 @@ struct CompareArgs {
   bool json = false;
 };
 
+// The provenance an input carries (a `dicesim toss --json` file's "provenance"), else null (a CSV of counts).
+nlohmann::json input_provenance(const std::string& path) {
+  std::ifstream in(path);
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  return j.is_object() && j.contains("provenance") ? j["provenance"] : nlohmann::json(nullptr);
+}
+
+// What made the comparison: this build, and each input's own provenance (null when it has none).
+nlohmann::json compare_provenance(const CompareArgs& a) {
+  const Provenance self;
+  return {{"version", self.version},
+          {"dirty", self.dirty < 0 ? nlohmann::json(nullptr) : nlohmann::json(self.dirty == 1)},
+          {"a", input_provenance(a.a)},
+          {"b", input_provenance(a.b)}};
+}
+
 int run_compare(const CompareArgs& a) {
   const FaceCounts ca = read_face_counts(a.a), cb = read_face_counts(a.b);
   Comparison c;
@@ -38,12 +55,22 @@ int run_compare(const CompareArgs& a) {
                        {"differs", f.ci95.lo > 0.0 || f.ci95.hi < 0.0}});
     const nlohmann::json j = {{"a", a.a}, {"b", a.b}, {"n_a", c.n_a}, {"n_b", c.n_b},
                               {"chi2", chi2_json(c.chi2)},
-                              {"min_expected", c.min_expected}, {"alpha", a.alpha}, {"differ", differ}, {"faces", faces}};
+                              {"min_expected", c.min_expected}, {"alpha", a.alpha}, {"differ", differ}, {"faces", faces},
+                              {"provenance", compare_provenance(a)}};
     std::printf("%s\n", j.dump().c_str());
     return kExitOk;
   }
-  std::printf("A: %s (n = %llu)\nB: %s (n = %llu)\n\n", a.a.c_str(), static_cast<unsigned long long>(c.n_a), a.b.c_str(),
+  std::printf("A: %s (n = %llu)\nB: %s (n = %llu)\n", a.a.c_str(), static_cast<unsigned long long>(c.n_a), a.b.c_str(),
               static_cast<unsigned long long>(c.n_b));
+  const nlohmann::json prov = compare_provenance(a);
+  std::printf("dicesim %s\n", Provenance().version.c_str());
+  for (const char* k : {"a", "b"})
+    if (!prov[k].is_null())
+      std::printf("%s made by dicesim %s from %s (scene sha256 %s, seed %s, fidelity %s)\n", k[0] == 'a' ? "A" : "B",
+                  prov[k].value("version", "?").c_str(), prov[k].value("scene", "?").c_str(),
+                  prov[k].value("scene_sha256", "?").c_str(), prov[k].contains("seed") ? prov[k]["seed"].dump().c_str() : "?",
+                  prov[k].value("fidelity", "?").c_str());
+  std::printf("\n");
   std::printf("face   count A     p A    count B     p B    p A - p B   95%% interval (Newcombe)\n");
   for (const FaceDifference& f : c.faces)
     std::printf("%4d %9llu  %7.4f %9llu  %7.4f   %+8.4f    [%+.4f, %+.4f]%s\n", f.label,
