@@ -15,6 +15,7 @@
 #include "aggregator/session.hpp"
 #include "aggregator/target.hpp"
 #include "apps/commands.hpp"
+#include "apps/fidelity_name.hpp"
 #include "apps/progress.hpp"
 #include "apps/report.hpp"
 #include "logger/log.hpp"
@@ -40,8 +41,9 @@ void AggregateArgs::add_to(CLI::App* cmd) {
   cmd->add_option("--lcm", lcm,
                   "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0, which never leaves this host)")
       ->type_name("URL");
-  tosses_opt = cmd->add_option("-n,--tosses", tosses, "Number of tosses (with --target-halfwidth: the most it may take)")
-                   ->capture_default_str()
+  tosses_opt = cmd->add_option("-n,--tosses", tosses, "Number of tosses (default 100000). With --target-halfwidth: the most it may take when\n"
+                                     "given; without -n, as many as the target needs (up to 10^9).\n"
+                                     "Any exact whole number: 100000, 1e5, 100_000")
                    ->check(CLI::Range(1ULL, 1ULL << 40));
   cmd->add_option("--seed", seed, "Run seed (with the toss index, the only source of randomness)")->capture_default_str();
   cmd->add_option("--trace-every", trace_every,
@@ -89,6 +91,7 @@ PreparedRun prepare_run(const AggregateArgs& a, std::int64_t run_id) {
   // Bad input fails here, before anything is published (SceneError -> exit 2 in run_cli).
   DieModel model = compile(a.scene.load(), a.scene.path);
   std::vector<std::string> overrides = a.scene.overrides;  // as SceneArgs::load composes them
+  check_fidelity_name(a.scene.fidelity);
   if (!a.scene.fidelity.empty()) overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
   const std::uint64_t total = a.target_halfwidth > 0 && a.tosses_opt && a.tosses_opt->count() == 0 ? kTargetCap : a.tosses;
   wire::RunSpec spec = wire::make_run_spec(run_id != 0 ? run_id : wire::new_run_id(), a.scene.path, overrides, model, a.seed,

@@ -89,9 +89,19 @@ void register_toss(CLI::App& app, int& exit_code) {
       "  dicesim toss scenes/paper/die1.toml --tosses 1000000 --threads 2 --json\n"
       "  dicesim toss scenes/fair.toml --set throw.height.mean=0.5 --set sim.stop_speed=0.01\n"
       "  dicesim toss scenes/paper/die3.toml --target-halfwidth 0.002   # as many tosses as that takes");
+  cmd->footer(
+      "\nWhich fidelity (--fidelity; scenes/README.md, docs/fidelity.md):\n"
+      "  auto     the cheapest model measured adequate for this scene at this run's precision, else\n"
+      "           impulse (`dicesim info SCENE` says which and why)\n"
+      "  impulse  a real, unfair die or coin: friction, rolling, tipping to rest; its accuracy knob is\n"
+      "           sim.contact_step (default 3 ms for polyhedra, 1 ms for cylinders)\n"
+      "  stepped  the reference (fixed 0.2 ms steps), over 10x slower than impulse: to check a new die\n"
+      "  paper    only to reproduce the seed's tables (frictionless corners, a rebound-speed stop)\n"
+      "  static   a die placed, not thrown (random orientation, quasi-static roll); instant");
   args->scene.add_to(cmd);
-  args->tosses_opt = cmd->add_option("-n,--tosses", args->tosses, "Number of tosses (with --target-halfwidth: the most it may take)")
-                         ->capture_default_str()
+  args->tosses_opt = cmd->add_option("-n,--tosses", args->tosses, "Number of tosses (default 100000). With --target-halfwidth: the most it may take when\n"
+                                     "given; without -n, as many as the target needs (up to 10^9).\n"
+                                     "Any exact whole number: 100000, 1e5, 100_000")
                          ->check(CLI::Range(1ULL, 1ULL << 40));
   cmd->add_option("--seed", args->seed, "Run seed (with the toss index, the only source of randomness)")
       ->capture_default_str();

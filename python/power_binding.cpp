@@ -18,9 +18,15 @@ std::string labels_text(const std::vector<int>& labels) {
   return t + "]";
 }
 
-pb::object do_power(Scene& scene, const std::shared_ptr<Scene>& against, std::optional<double> detect_bias, std::uint64_t n,
+pb::object do_power(const pb::object& scene_given, const std::shared_ptr<Scene>& against, std::optional<double> detect_bias,
+                    const pb::object& n_given,
                     double alpha, double power, std::uint64_t replicates, int bootstrap, std::uint64_t seed, int threads,
                     std::optional<std::string> fidelity, const pb::object& progress) {
+  const std::shared_ptr<Scene> held = scene_arg(scene_given);
+  Scene& scene = *held;
+  const std::optional<std::uint64_t> counted = count_arg(n_given, "n");
+  if (!counted) throw pb::type_error("n must be a whole number, got None");
+  const std::uint64_t n = *counted;
   if ((against != nullptr) == detect_bias.has_value())
     throw pb::value_error("give exactly one of against (a Scene) or detect_bias (a shift in (0, 0.5])");
   if (!(alpha > 0.0 && alpha < 1.0)) throw pb::value_error("alpha must be in (0, 1), got " + std::to_string(alpha));

@@ -275,11 +275,15 @@ SweepSpec load_sweep_file(const std::string& path) {
     if (!fs::is_regular_file(s.seed_table)) t.fail("seed_table", "\"" + *st + "\"", "cannot open '" + s.seed_table + "'");
   }
   s.seed_tosses = t.count("seed_tosses", 1, 1ULL << 40).value_or(0);
+  if (const auto ref = t.num("reference")) {
+    if (!(*ref > 0.0 && *ref < 1.0)) t.fail("reference", number_text(*ref), "must be a probability in (0, 1), e.g. 0.3333333333333333");
+    s.reference = *ref;
+  }
 
   const toml::node* param = t.get("param");
   const toml::node* points = t.get("points");
   t.finish({"title", "reproduces", "scene", "tosses", "seed", "set", "seed_table", "seed_tosses", "x_label", "reading",
-            "notes", "param", "points"});
+            "notes", "reference", "param", "points"});
   if ((param != nullptr) == (points != nullptr))
     t.fail(param ? "points" : "param", "", "give exactly one of [sweep.param] (a key and values) or [[sweep.points]]");
 
@@ -341,8 +345,16 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
   for (const SweepPoint& p : spec.points) {
     std::vector<std::string> all = spec.overrides;
     all.insert(all.end(), p.overrides.begin(), p.overrides.end());
-    models.push_back(compile(load_scene(spec.scene, all), spec.scene));
-    hashes.push_back(scene_sha256(spec.scene, all));
+    // A point that fails says which point: its key and value may differ from the one that broke.
+    const std::string where = "sweep point " + spec.x_label + " = " + p.label;
+    try {
+      models.push_back(compile(load_scene(spec.scene, all), spec.scene));
+      hashes.push_back(scene_sha256(spec.scene, all));
+    } catch (const SceneError& e) {
+      throw SceneError(e.file(), e.key(), e.value(), e.allowed() + " (at " + where + ")");
+    } catch (const std::exception& e) {
+      throw std::runtime_error(where + ": " + e.what());
+    }
     // One table: the same outcomes at every point (a sweep of die.sides is a sweep per die).
     const std::vector<int>& labels = models.back().outcome_labels;
     auto text = [](const std::vector<int>& v) {

@@ -59,6 +59,7 @@ struct SweepSpec {
   std::string scene;                     // base scene path
   std::vector<std::string> overrides;    // applied at every point, before the point's own
   std::string x_label;                   // axis label (default: the key)
+  double reference = 0.0;                // the question's probability (a line on the plot), e.g. 1/3; 0: none
   std::vector<SweepPoint> points;
   bool categorical = false;              // points carry their own labels ([[sweep.points]])
   std::uint64_t tosses = 10000;
