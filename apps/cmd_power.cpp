@@ -9,6 +9,7 @@
 #include "apps/power_report.hpp"
 #include "apps/progress.hpp"
 #include "sim/models/compile.hpp"
+#include "sim/study/auto_pilot.hpp"
 #include "sim/scene/scene_error.hpp"
 #include "sim/study/sweep.hpp"
 
@@ -52,12 +53,15 @@ void check(const PowerArgs& a) {
 int run_power(const PowerArgs& a) {
   check(a);
   const auto t0 = std::chrono::steady_clock::now();
-  const DieModel model = compile(a.scene.load(), a.scene.path);
+  DieModel model = compile(a.scene.load(), a.scene.path);
+  // auto: each scene's pilot at the study's simulated tosses.
+  resolve_auto(model, precision_of_run(model, a.tosses), a.threads);
   std::unique_ptr<DieModel> other;
   if (!a.against.empty()) {
     SceneArgs b = a.scene;  // --set and --fidelity apply to both scenes
     b.path = a.against;
     other = std::make_unique<DieModel>(compile(b.load(), b.path));
+    resolve_auto(*other, precision_of_run(*other, a.tosses), a.threads);
     if (other->outcome_labels != model.outcome_labels)
       throw SceneError(a.against, "outcome labels", labels_text(other->outcome_labels),
                        "must equal those of " + a.scene.path + " " + labels_text(model.outcome_labels) +

@@ -175,6 +175,9 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
                         {"unresolved", r.counts.unresolved},
                         {"invalid", r.counts.invalid},
                         {"corrections", corrections_json(r.counts.corrections)},
+                        {"fidelity", r.fidelity},  // auto: each point's own pilot (its reason and numbers)
+                        {"fidelity_reason", r.fidelity_reason},
+                        {"pilot", pilot_json(r.pilot)},
                         {"faces", faces}};
     const SeedMatch m = match_seed(spec, seed_rows, r);
     if (m.found) {
@@ -216,6 +219,12 @@ std::string table_text(const SweepSpec& spec, const SweepResult& res, int thread
       << ", seed " << spec.seed << ", " << spec.tosses << " tosses per point, ";
   if (workers > 0) out << workers << " worker process" << (workers == 1 ? "" : "es") << ")\n\n";
   else out << threads << " thread" << (threads == 1 ? "" : "s") << ")\n\n";
+  if (!res.points.empty() && res.points[0].fidelity_reason.rfind("auto", 0) == 0) {
+    // auto: each point's pilot chose its model (--json: each point's reason and pilot).
+    out << "auto, each point's pilot at " << spec.tosses << " tosses:";
+    for (const SweepPointResult& r : res.points) out << " " << r.point.label << " " << r.fidelity << ";";
+    out << "\n\n";
+  }
   const auto first = res.points.empty() ? std::vector<FaceEstimate>{} : face_estimates(res.points[0].counts, res.points[0].labels);
   char line[512];
   std::snprintf(line, sizeof line, "%-14s", spec.x_label.size() <= 14 ? spec.x_label.c_str() : "x");

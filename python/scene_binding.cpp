@@ -5,7 +5,9 @@
 #include <pybind11/stl.h>
 
 #include "apps/info_json.hpp"
+#include "apps/report.hpp"
 #include "python/bindings.hpp"
+#include "sim/study/auto_pilot.hpp"
 #include "sim/models/compile.hpp"
 
 namespace dicesim::py {
@@ -116,7 +118,13 @@ void register_scene(pb::module_& m) {
           "The outcome labels: distinct face labels, ascending (the order of Result.counts).")
       .def(
           "info",
-          [](Scene& s, std::optional<std::string> fidelity) { return json_to_python(info_json(s.origin(), *s.model(fidelity))); },
+          [](Scene& s, std::optional<std::string> fidelity) {
+            DieModel m = *s.model(fidelity);
+            const FidelityPilot pilot = resolve_auto(m, precision_of_run(m, 100000), resolve_threads(0));  // as `dicesim info`
+            nlohmann::json j = info_json(s.origin(), m);
+            j["pilot"] = pilot_json(pilot);
+            return json_to_python(j);
+          },
           pb::arg("fidelity") = pb::none(),
           "What the scene compiles to, as a dict: exactly `dicesim info SCENE --json`'s object (mass,\n"
           "com, inertia, principal_moments, principal_axes, faces, corners, fidelity, rest, ...).")

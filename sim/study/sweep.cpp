@@ -1,5 +1,6 @@
 #include "sim/models/compile.hpp"
 #include "sim/study/sweep.hpp"
+#include "sim/study/auto_pilot.hpp"
 
 #include "sim/body/outcome.hpp"
 
@@ -334,12 +335,18 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   // Every point is loaded and compiled before the first toss: a bad value fails at once.
   std::vector<DieModel> models;
+  std::vector<FidelityPilot> pilots;
   std::vector<std::vector<std::string>> overrides;
   models.reserve(spec.points.size());
   for (const SweepPoint& p : spec.points) {
     std::vector<std::string> all = spec.overrides;
     all.insert(all.end(), p.overrides.begin(), p.overrides.end());
     models.push_back(compile(load_scene(spec.scene, all), spec.scene));
+    // auto: each point's own pilot at the sweep's tosses per point (a point's scene is its own);
+    // the choice is passed on as an override, so that workers of a distributed sweep toss it too.
+    pilots.push_back(resolve_auto(models.back(), precision_of_run(models.back(), spec.tosses), opt.threads));
+    if (models.back().fidelity_requested == Fidelity::Auto)
+      all.push_back(std::string("sim.fidelity=\"") + to_string(models.back().fidelity) + "\"");
     // One table: the same outcomes at every point (a sweep of die.sides is a sweep per die).
     const std::vector<int>& labels = models.back().outcome_labels;
     auto text = [](const std::vector<int>& v) {
@@ -384,6 +391,8 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
     if (opt.cancel && opt.cancel->load()) break;  // a cancelled point is incomplete: not reported
     r.labels = models[i].outcome_labels;
     r.fidelity = to_string(models[i].fidelity);
+    r.fidelity_reason = models[i].fidelity_reason;
+    r.pilot = pilots[i];
     out.points.push_back(std::move(r));
     if (opt.progress) opt.progress(before + spec.tosses, total);
   }

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/study/auto_pilot.hpp"
 #include "sim/study/monte_carlo.hpp"
 #include "sim/study/statistics.hpp"
 
@@ -88,6 +89,8 @@ struct SweepPointResult {
   RunCounts counts;
   std::vector<int> labels;  // the model's outcome labels (counts.faces in this order)
   std::string fidelity;
+  std::string fidelity_reason;  // why (auto: each point's own pilot, at the sweep's tosses per point)
+  FidelityPilot pilot;
 };
 
 struct SweepResult {
