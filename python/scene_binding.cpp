@@ -123,6 +123,7 @@ void register_scene(pb::module_& m) {
             const FidelityPilot pilot = resolve_auto(m, precision_of_run(m, 100000), resolve_threads(0));  // as `dicesim info`
             nlohmann::json j = info_json(s.origin(), m);
             j["pilot"] = pilot_json(pilot);
+            if (j["pilot"].is_object()) j["pilot"].erase("seconds");  // as `dicesim info --json`
             return json_to_python(j);
           },
           pb::arg("fidelity") = pb::none(),
