@@ -213,6 +213,13 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   r.tosses = res.tosses;
   r.counts = res.counts;
   set_labels(r, model);
+  // auto: the pilot's numbers as `toss` reports them (prepare_run resolved the model; the pilot is a
+  // function of the scene and the run's size, so running it again gives the same numbers).
+  if (!resume && model.fidelity_requested == Fidelity::Auto) {
+    DieModel again = model;
+    r.pilot = resolve_auto(again, a.target_halfwidth > 0 ? precision_of_target(again, a.target_halfwidth) : precision_of_run(again, a.tosses),
+                           static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  }
   r.elapsed_s = res.run_elapsed_s;
   print_report(r, a.json);
   return kExitOk;
