@@ -280,6 +280,9 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
                         {"unresolved", r.counts.unresolved},
                         {"invalid", r.counts.invalid},
                         {"corrections", corrections_json(r.counts.corrections)},
+                        {"fidelity", r.fidelity},  // auto: each point's own pilot (its reason and numbers)
+                        {"fidelity_reason", r.fidelity_reason},
+                        {"pilot", pilot_json(r.pilot)},
                         {"faces", faces},
                         {"scene_sha256", r.scene_sha256}};
     if (r.partial) {
@@ -337,6 +340,11 @@ std::string table_text(const SweepSpec& spec, const SweepResult& res, int thread
     if (whole < res.points.size())
       out << " (point " << res.points.back().point.label << ": the first " << res.points.back().counts.total() << " of "
           << spec.tosses << " tosses)";
+    }
+  if (!res.points.empty() && res.points[0].fidelity_reason.rfind("auto", 0) == 0) {
+    // auto: each point's pilot chose its model (--json: each point's reason and pilot).
+    out << "auto, each point's pilot at " << spec.tosses << " tosses:";
+    for (const SweepPointResult& r : res.points) out << " " << r.point.label << " " << r.fidelity << ";";
     out << "\n";
   }
   out << "\n";

@@ -11,6 +11,7 @@
 #include "sim/body/die_model.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/scene/scene_hash.hpp"
+#include "sim/study/auto_pilot.hpp"
 #include "sim/study/monte_carlo.hpp"
 
 namespace dicesim {
@@ -28,7 +29,11 @@ struct TossArgs {
 
 int run_toss(const TossArgs& a) {
   const SceneDef def = a.scene.load();
-  const DieModel model = compile(def, a.scene.path);
+  DieModel model = compile(def, a.scene.path);
+  // auto: the pilot judges the cheaper models at this run's precision (its N, or the target).
+  const FidelityPilot pilot = resolve_auto(model,
+               a.target_halfwidth > 0.0 ? precision_of_target(model, a.target_halfwidth) : precision_of_run(model, a.tosses),
+               a.threads);
 
   const InterruptGuard interrupt;
   ProgressBar bar;
@@ -67,6 +72,7 @@ int run_toss(const TossArgs& a) {
   r.tosses = tosses;
   r.counts = counts;
   set_labels(r, model);
+  r.pilot = pilot;
   r.elapsed_s = elapsed;
   print_report(r, a.json);
   if (partial) std::fprintf(stderr, "dicesim: interrupted after %llu of %llu tosses\n", static_cast<unsigned long long>(tosses),

@@ -561,6 +561,7 @@ void read_sim(Reader sim, SimDef& def) {
 
 SceneDef build(const toml::table& tree, const std::string& origin, const std::string& default_name) {
   SceneDef s = default_scene_def();
+  s.sim.fidelity = Fidelity::Auto;  // a scene file that names no model gets the measured choice (issue 35)
   Reader top(&tree, "", origin);
   s.name = top.string("name").value_or(default_name);
   if (s.name.empty()) top.fail(top.get("name"), "name", "must be a non-empty string");

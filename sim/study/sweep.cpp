@@ -1,6 +1,7 @@
 #include "sim/models/compile.hpp"
 #include "sim/scene/scene_hash.hpp"
 #include "sim/study/sweep.hpp"
+#include "sim/study/auto_pilot.hpp"
 
 #include "sim/body/outcome.hpp"
 
@@ -339,6 +340,7 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   // Every point is loaded and compiled before the first toss: a bad value fails at once.
   std::vector<DieModel> models;
+  std::vector<FidelityPilot> pilots;
   std::vector<std::vector<std::string>> overrides;
   std::vector<std::string> hashes;
   models.reserve(spec.points.size());
@@ -355,6 +357,11 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
     } catch (const std::exception& e) {
       throw std::runtime_error(where + ": " + e.what());
     }
+    // auto: each point's own pilot at the sweep's tosses per point (a point's scene is its own);
+    // the choice is passed on as an override, so that workers of a distributed sweep toss it too.
+    pilots.push_back(resolve_auto(models.back(), precision_of_run(models.back(), spec.tosses), opt.threads));
+    if (models.back().fidelity_requested == Fidelity::Auto)
+      all.push_back(std::string("sim.fidelity=\"") + to_string(models.back().fidelity) + "\"");
     // One table: the same outcomes at every point (a sweep of die.sides is a sweep per die).
     const std::vector<int>& labels = models.back().outcome_labels;
     auto text = [](const std::vector<int>& v) {
@@ -406,6 +413,7 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
     r.fidelity = to_string(models[i].fidelity);
     r.fidelity_reason = models[i].fidelity_reason;
     r.scene_sha256 = hashes[i];
+    r.pilot = pilots[i];
     out.points.push_back(std::move(r));
     if (cancelled) break;
     if (opt.progress) opt.progress(before + spec.tosses, total);
