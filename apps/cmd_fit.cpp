@@ -11,10 +11,12 @@
 #include <thread>
 
 #include "apps/commands.hpp"
+#include "apps/fidelity_name.hpp"
 #include "apps/fit_json.hpp"
 #include "apps/gnuplot.hpp"
 #include "apps/interrupt.hpp"
 #include "apps/output_path.hpp"
+#include "sim/scene/key_unit.hpp"
 #include "apps/progress.hpp"
 #include "sim/scene/scene_error.hpp"
 #include "sim/study/fit.hpp"
@@ -40,11 +42,22 @@ void write_profile_plot(const std::string& path, const FitResult& r) {
   std::ostringstream gp;
   const int d = static_cast<int>(r.params.size());
   gp << gnuplot_terminal(path, 480 * d + 60, 420);
+  std::string scenes;
+  std::uint64_t observed = 0;
+  for (const FitDataResult& data : r.data) {
+    if (scenes.find(data.scene) == std::string::npos) scenes += (scenes.empty() ? "" : ", ") + data.scene;
+    for (const auto c : data.observed) observed += c;
+  }
   gp << "set multiplot layout 1," << d << " title "
-     << gnuplot_quote("profile likelihood, " + std::to_string(r.simulated_tosses) + " tosses simulated") << " noenhanced\n";
-  gp << "set grid\nset border 3\nset tics nomirror\nset ylabel '2 (l_max - l_profile)' noenhanced\nset key top center\n";
+     << gnuplot_quote("profile likelihood: " + scenes + ", fidelity " + r.fidelity + "\n" + std::to_string(observed) +
+                      " observed tosses, " + std::to_string(r.simulated_tosses) + " simulated")
+     << " noenhanced\n";
+  // The legend below the axes: at the top centre it covered the profile's minimum.
+  gp << "set grid\nset border 3\nset tics nomirror\nset ylabel '2 (l_max - l_profile)' noenhanced\n"
+        "set key below horizontal noenhanced\n";
   for (const FitParamResult& p : r.params) {
-    gp << "set xlabel " << gnuplot_quote(p.key) << " noenhanced\n";
+    const std::string unit = key_unit(p.key);
+    gp << "set xlabel " << gnuplot_quote(unit.empty() ? p.key : p.key + " (" + unit + ")") << " noenhanced\n";
     gp << "set yrange [0:8]\n";
     gp << "set arrow from " << number_text(p.ci95.lo) << ",0 to " << number_text(p.ci95.lo) << ",3.841 nohead dt 2\n";
     gp << "set arrow from " << number_text(p.ci95.hi) << ",0 to " << number_text(p.ci95.hi) << ",3.841 nohead dt 2\n";
@@ -135,6 +148,7 @@ int run_fit_cmd(const FitArgs& a) {
   check_output_path("dicesim fit", "--plot", a.plot);  // before any toss
   FitOptions opt;
   opt.overrides = a.scene.overrides;
+  check_fidelity_name(a.scene.fidelity);
   if (!a.scene.fidelity.empty()) opt.overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
   opt.seed = a.seed;
   opt.threads = a.threads;

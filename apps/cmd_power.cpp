@@ -11,6 +11,7 @@
 #include "apps/progress.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/scene/scene_hash.hpp"
+#include "sim/study/auto_pilot.hpp"
 #include "sim/scene/scene_error.hpp"
 #include "sim/study/sweep.hpp"
 
@@ -55,7 +56,9 @@ int run_power(const PowerArgs& a) {
   check(a);
   const auto t0 = std::chrono::steady_clock::now();
   const SceneDef def = a.scene.load();
-  const DieModel model = compile(def, a.scene.path);
+  DieModel model = compile(def, a.scene.path);
+  // auto: each scene's pilot at the study's simulated tosses.
+  resolve_auto(model, precision_of_run(model, a.tosses), a.threads);
   std::unique_ptr<DieModel> other;
   std::string against_sha256;
   if (!a.against.empty()) {
@@ -64,6 +67,7 @@ int run_power(const PowerArgs& a) {
     const SceneDef def_b = b.load();
     against_sha256 = scene_sha256(b.path, b.applied_overrides());
     other = std::make_unique<DieModel>(compile(def_b, b.path));
+    resolve_auto(*other, precision_of_run(*other, a.tosses), a.threads);
     if (other->outcome_labels != model.outcome_labels)
       throw SceneError(a.against, "outcome labels", labels_text(other->outcome_labels),
                        "must equal those of " + a.scene.path + " " + labels_text(model.outcome_labels) +

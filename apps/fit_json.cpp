@@ -54,6 +54,7 @@ nlohmann::json fit_json(const FitResult& r, const FitOptions& opt) {
           {"data", data},
           {"loglik", json_number(r.loglik)},
           {"fidelity", r.fidelity},
+          {"fidelity_reason", r.fidelity_reason},
           {"seed", opt.seed},
           {"rounds", rounds},
           {"simulated_tosses", r.simulated_tosses},

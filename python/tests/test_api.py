@@ -32,6 +32,17 @@ def test_to_dict_is_cli_json(dicesim, args):
     assert d["elapsed_s"] == pytest.approx(r.elapsed_s)
 
 
+def test_auto_is_resolved_as_the_cli_does(dicesim):
+    # A scene that names no model runs auto: the same pilot, choice and counts as `dicesim toss`.
+    caught = "scenes/coins/quarter-caught.toml"
+    r = dicesim.toss(dicesim.load_scene(caught), 100000, seed=4, threads=2)
+    d = r.to_dict()
+    assert d["fidelity_requested"] == "auto" and d["fidelity"] == "paper"
+    assert d["pilot"]["candidates"][-1]["adequate"] and d["pilot"]["tosses"] > 0
+    expected = cli_json("toss", caught, "-n", "100000", "--seed", "4", "--threads", "2")
+    assert without_timing(d) == without_timing(expected)
+
+
 def test_overrides_are_the_clis_set(dicesim):
     scene = dicesim.load_scene(DIE1, set={"materials.steel.restitution": 0.9, "throw.height.mean": 0.5,
                                           "sim.fidelity": "paper"})
