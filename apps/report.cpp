@@ -121,9 +121,11 @@ std::string report_table(const RunReport& r) {
   out += line;
   out += provenance_lines(r.provenance);
   if (r.partial) {
-    std::snprintf(line, sizeof line, "interrupted after %llu of %llu tosses (a complete prefix: the same counts as -n %llu)\n",
+    // With --fidelity of the model run: auto would judge a shorter run at its own precision.
+    std::snprintf(line, sizeof line,
+                  "interrupted after %llu of %llu tosses (a complete prefix: the same counts as -n %llu --fidelity %s)\n",
                   static_cast<unsigned long long>(r.tosses), static_cast<unsigned long long>(r.provenance.tosses),
-                  static_cast<unsigned long long>(r.tosses));
+                  static_cast<unsigned long long>(r.tosses), r.fidelity.c_str());
     out += line;
   }
   if (r.fidelity_requested == "auto" && r.pilot.ran)  // how auto chose (the reason is in the provenance lines)
