@@ -7,6 +7,7 @@
 
 #include "aggregator/checkpoint.hpp"
 #include "apps/commands.hpp"
+#include "apps/provenance.hpp"
 #include "apps/fidelity_name.hpp"
 #include "apps/number_forms.hpp"
 #include "messages/auth.hpp"
@@ -31,12 +32,14 @@ void check_fidelity_name(const std::string& fidelity) {
     throw SceneError("--fidelity", "", "", "'" + fidelity + "' is not a fidelity; " + kFidelityChoices);
 }
 
-SceneDef SceneArgs::load() const {
+std::vector<std::string> SceneArgs::applied_overrides() const {
   std::vector<std::string> all = overrides;
   check_fidelity_name(fidelity);
   if (!fidelity.empty()) all.push_back("sim.fidelity=\"" + fidelity + "\"");
-  return load_scene(path, all);
+  return all;
 }
+
+SceneDef SceneArgs::load() const { return load_scene(path, applied_overrides()); }
 
 CLI::Option* add_key_file_option(CLI::App* cmd, std::string& path) {
   return cmd->add_option("--key-file", path,
@@ -58,6 +61,8 @@ int parse_and_run(CLI::App& app, int argc, char** argv, const int& exit_code) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "%s: %s\nRun with --help for usage.\n", app.get_name().c_str(), e.what());
@@ -147,6 +152,8 @@ int run_cli(int argc, char** argv) {
   register_watch(app, exit_code);
   register_record(app, exit_code);
   register_replay(app, exit_code);
+  register_version(app, exit_code);
+  app.set_version_flag("--version", std::string("dicesim ") + git_describe(), "Print the version and exit (dicesim version: the build)");
   accept_number_forms(app);
   if (argc >= 2 && argv[1][0] != '-') {
     const auto subs = app.get_subcommands({});

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <optional>
+#include <thread>
 #include <csignal>
 #include <cstdio>
 
@@ -20,9 +21,11 @@
 #include "apps/report.hpp"
 #include "logger/log.hpp"
 #include "messages/run_spec.hpp"
+#include "messages/spec_scene.hpp"
 #include "messages/wire.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/models/compile.hpp"
+#include "sim/study/auto_pilot.hpp"
 
 namespace dicesim {
 namespace {
@@ -93,6 +96,12 @@ PreparedRun prepare_run(const AggregateArgs& a, std::int64_t run_id) {
   check_fidelity_name(a.scene.fidelity);
   if (!a.scene.fidelity.empty()) overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
   const std::uint64_t total = a.target_halfwidth > 0 && a.tosses_opt && a.tosses_opt->count() == 0 ? kTargetCap : a.tosses;
+  // auto: the pilot runs here, once; the workers are told the model it chose (an override), so
+  // every process tosses the same model without a pilot of its own.
+  resolve_auto(model, a.target_halfwidth > 0 ? precision_of_target(model, a.target_halfwidth) : precision_of_run(model, a.tosses),
+               static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  if (model.fidelity_requested == Fidelity::Auto)
+    overrides.push_back(std::string("sim.fidelity=\"") + to_string(model.fidelity) + "\"");
   wire::RunSpec spec = wire::make_run_spec(run_id != 0 ? run_id : wire::new_run_id(), a.scene.path, overrides, model, a.seed,
                                            total, a.trace_every);
   return {std::move(model), std::move(spec)};
@@ -208,7 +217,15 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   r.tosses = res.tosses;
   r.counts = res.counts;
   set_labels(r, model);
+  // auto: the pilot's numbers as `toss` reports them (prepare_run resolved the model; the pilot is a
+  // function of the scene and the run's size, so running it again gives the same numbers).
+  if (!resume && model.fidelity_requested == Fidelity::Auto) {
+    DieModel again = model;
+    r.pilot = resolve_auto(again, a.target_halfwidth > 0 ? precision_of_target(again, a.target_halfwidth) : precision_of_run(again, a.tosses),
+                           static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  }
   r.elapsed_s = res.run_elapsed_s;
+  r.provenance = make_provenance(spec.origin, spec.overrides, wire::spec_scene_sha256(spec), model, spec.seed, spec.total, r.threads);
   print_report(r, a.json);
   return kExitOk;
 }

@@ -11,6 +11,7 @@
 #include "apps/commands.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/models/compile.hpp"
+#include "sim/study/auto_pilot.hpp"
 #include "sim/study/monte_carlo.hpp"
 
 namespace dicesim {
@@ -63,7 +64,9 @@ const char* phase_unit(Phase p) {
 nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
   SceneArgs sa = a.scene;
   if (!fidelity.empty()) sa.fidelity = fidelity;
-  const DieModel m = compile(sa.load(), sa.path);
+  DieModel m = compile(sa.load(), sa.path);
+  // auto: the model a `toss` of this many tosses (default 100000) would take; the pilot is not timed.
+  resolve_auto(m, precision_of_run(m, a.tosses > 0 ? a.tosses : 100000), a.threads);
   const std::uint64_t n = a.tosses > 0 ? a.tosses : default_tosses(m.fidelity);
 
   RunCounts one, many;

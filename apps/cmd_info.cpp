@@ -1,14 +1,18 @@
 // dicesim info: what the scene compiles to: mass properties, principal frame, faces, corners.
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
+#include <thread>
 #include <vector>
 
 #include "apps/commands.hpp"
 #include "apps/info_json.hpp"
+#include "apps/report.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/body/material_parts.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/models/fidelity_models.hpp"
+#include "sim/study/auto_pilot.hpp"
 
 namespace dicesim {
 namespace {
@@ -108,12 +112,27 @@ void print_info(const std::string& path, const DieModel& m, const FloorDef& floo
   std::printf("\n  why              %s\n", m.fidelity_reason.c_str());
 }
 
+void print_pilot(const FidelityPilot& p) {
+  if (!p.ran) return;
+  // Its cost in tosses, not seconds: info prints the same for the same inputs (toss reports the time).
+  std::printf("  pilot            %llu tosses (seed %llu; full size %llu pairs, cap %llu)\n",
+              static_cast<unsigned long long>(p.tosses), static_cast<unsigned long long>(p.seed),
+              static_cast<unsigned long long>(p.max_pairs), static_cast<unsigned long long>(p.cap));
+  for (const PilotCandidate& c : p.candidates)
+    std::printf("    %-8s       differs from impulse in %llu of %llu pairs: bias <= %.3g (upper 95%%), %s\n",
+                to_string(c.model), static_cast<unsigned long long>(c.differing), static_cast<unsigned long long>(c.pairs),
+                c.bound, c.adequate ? "adequate" : "not adequate");
+  std::printf("    adequate when  bias < %.3g = %.2g x the half-width %.3g of %s\n", p.threshold, p.fraction,
+              p.halfwidth, p.precision.c_str());
+}
+
 }  // namespace
 
 void register_info(CLI::App& app, int& exit_code) {
   struct Args {
     SceneArgs scene;
     bool json = false;
+    std::uint64_t tosses = 100000;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -125,14 +144,26 @@ void register_info(CLI::App& app, int& exit_code) {
   args->scene.add_to(cmd);
   cmd->add_flag("--json", args->json, "One JSON object: shape, vertex_count, face_count, faces [{label, normal, area, stable,\n"
                 "p_static}], mass, com, inertia (3x3), principal_moments, ...");
+  cmd->add_option("-n,--tosses", args->tosses,
+                  "The run size a scene that names no fidelity (auto) is judged for: its pilot decides as\n"
+                  "`dicesim toss -n N` would")
+      ->capture_default_str()
+      ->check(CLI::Range(1ULL, 1ULL << 40));
   cmd->callback([args, &exit_code] {
     const SceneDef def = args->scene.load();
-    const DieModel m = compile(def, args->scene.path);
+    DieModel m = compile(def, args->scene.path);
     const std::vector<MaterialPart> parts = material_parts(def, args->scene.path);
-    if (args->json)
-      std::printf("%s\n", info_json(args->scene.path, m, parts).dump(2).c_str());
-    else
+    const FidelityPilot pilot =
+        resolve_auto(m, precision_of_run(m, args->tosses), static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+    if (args->json) {
+      nlohmann::json j = info_json(args->scene.path, m, parts);
+      j["pilot"] = pilot_json(pilot);
+      if (j["pilot"].is_object()) j["pilot"].erase("seconds");  // the same output for the same inputs
+      std::printf("%s\n", j.dump(2).c_str());
+    } else {
       print_info(args->scene.path, m, def.floor, parts);
+      print_pilot(pilot);
+    }
     exit_code = kExitOk;
   });
 }

@@ -18,6 +18,9 @@
 #include "apps/commands.hpp"
 #include "apps/fidelity_name.hpp"
 #include "apps/gnuplot.hpp"
+#include "apps/interrupt.hpp"
+#include "apps/output_path.hpp"
+#include "apps/provenance.hpp"
 #include "apps/progress.hpp"
 #include "apps/report.hpp"
 #include "apps/sweep_workers.hpp"
@@ -27,6 +30,7 @@
 #include "sim/scene/key_unit.hpp"
 #include "sim/study/compare.hpp"
 #include "sim/scene/scene_error.hpp"
+#include "sim/scene/scene_hash.hpp"
 #include "sim/study/sweep.hpp"
 
 namespace dicesim {
@@ -53,9 +57,6 @@ struct SweepArgs {
   std::string csv, plot, markdown;
   bool distributed() const { return workers > 0 || !lcm.empty(); }
 };
-
-std::atomic<bool> g_stop{false};
-void on_stop_signal(int) { g_stop = true; }
 
 // A point compared with the seed's row at the same x.
 struct SeedMatch {
@@ -233,8 +234,8 @@ void write_plot(const std::string& path, const SweepSpec& spec, const SweepResul
   run_gnuplot(gp.str(), path);
 }
 
-std::string csv_text(const SweepResult& res) {
-  std::string out = "param,face,count,p,lo,hi\n";
+std::string csv_text(const SweepResult& res, const Provenance& prov) {
+  std::string out = provenance_csv_comment(prov) + "param,face,count,p,lo,hi\n";
   for (const SweepPointResult& r : res.points)
     for (const FaceEstimate& f : face_estimates(r.counts, r.labels))
       out += number_text(r.point.x) + "," + std::to_string(f.label) + "," + std::to_string(f.count) + "," +
@@ -242,8 +243,29 @@ std::string csv_text(const SweepResult& res) {
   return out;
 }
 
+// The sweep's provenance: the base scene (every point's overrides but the swept key's) and its hash;
+// the fidelity and why of the first point (each point also carries its own scene hash).
+Provenance sweep_provenance(const SweepSpec& spec, const SweepResult& res, int threads) {
+  Provenance p;
+  p.scene = spec.scene;
+  p.scene_sha256 = scene_sha256(spec.scene, spec.overrides);
+  p.overrides = spec.overrides;
+  if (!res.points.empty()) {
+    p.fidelity = res.points[0].fidelity;
+    p.fidelity_reason = res.points[0].fidelity_reason;
+  }
+  p.seed = spec.seed;
+  p.tosses = spec.tosses;
+  p.threads = threads;
+  return p;
+}
+
+bool sweep_partial(const SweepSpec& spec, const SweepResult& res) {
+  return res.points.size() < spec.points.size() || (!res.points.empty() && res.points.back().partial);
+}
+
 nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const std::vector<ReferenceRow>& seed_rows,
-                           int threads, int workers) {
+                           int threads, int workers, const Provenance& prov) {
   nlohmann::json points = nlohmann::json::array();
   int compared = 0, rejected = 0;
   std::uint64_t tosses = 0;
@@ -258,7 +280,15 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
                         {"unresolved", r.counts.unresolved},
                         {"invalid", r.counts.invalid},
                         {"corrections", corrections_json(r.counts.corrections)},
-                        {"faces", faces}};
+                        {"fidelity", r.fidelity},  // auto: each point's own pilot (its reason and numbers)
+                        {"fidelity_reason", r.fidelity_reason},
+                        {"pilot", pilot_json(r.pilot)},
+                        {"faces", faces},
+                        {"scene_sha256", r.scene_sha256}};
+    if (r.partial) {
+      p["partial"] = true;
+      p["tosses"] = r.counts.total();
+    }
     const SeedMatch m = match_seed(spec, seed_rows, r);
     if (m.found) {
       p["seed"] = {{"p", m.p}};
@@ -282,8 +312,11 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
                       {"threads", threads},
                       {"workers", workers},
                       {"points", points},
+                      {"partial", sweep_partial(spec, res)},
+                      {"points_requested", spec.points.size()},
                       {"elapsed_s", res.elapsed_s},
                       {"tosses_per_s", res.elapsed_s > 0 ? static_cast<double>(tosses) / res.elapsed_s : 0.0}};
+  j["provenance"] = provenance_json(prov);
   if (!spec.seed_table.empty())
     j["seed_comparison"] = {{"table", spec.seed_table},
                             {"reproduces", spec.reproduces},
@@ -293,12 +326,28 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
   return j;
 }
 
-std::string table_text(const SweepSpec& spec, const SweepResult& res, int threads, int workers) {
+std::string table_text(const SweepSpec& spec, const SweepResult& res, int threads, int workers, const Provenance& prov) {
   std::ostringstream out;
   out << spec.title << "  (" << spec.scene << ", fidelity " << (res.points.empty() ? "" : res.points[0].fidelity)
       << ", seed " << spec.seed << ", " << spec.tosses << " tosses per point, ";
-  if (workers > 0) out << workers << " worker process" << (workers == 1 ? "" : "es") << ")\n\n";
-  else out << threads << " thread" << (threads == 1 ? "" : "s") << ")\n\n";
+  if (workers > 0) out << workers << " worker process" << (workers == 1 ? "" : "es") << ")\n";
+  else out << threads << " thread" << (threads == 1 ? "" : "s") << ")\n";
+  out << provenance_lines(prov);
+  if (sweep_partial(spec, res)) {
+    std::size_t whole = res.points.size();
+    if (whole > 0 && res.points.back().partial) --whole;
+    out << "interrupted after " << whole << " of " << spec.points.size() << " points";
+    if (whole < res.points.size())
+      out << " (point " << res.points.back().point.label << ": the first " << res.points.back().counts.total() << " of "
+          << spec.tosses << " tosses)";
+    }
+  if (!res.points.empty() && res.points[0].fidelity_reason.rfind("auto", 0) == 0) {
+    // auto: each point's pilot chose its model (--json: each point's reason and pilot).
+    out << "auto, each point's pilot at " << spec.tosses << " tosses:";
+    for (const SweepPointResult& r : res.points) out << " " << r.point.label << " " << r.fidelity << ";";
+    out << "\n";
+  }
+  out << "\n";
   const auto first = res.points.empty() ? std::vector<FaceEstimate>{} : face_estimates(res.points[0].counts, res.points[0].labels);
   char line[512];
   std::snprintf(line, sizeof line, "%-14s", spec.x_label.size() <= 14 ? spec.x_label.c_str() : "x");
@@ -423,41 +472,46 @@ int run_sweep_cmd(SweepArgs a) {
     const std::string ext = fs::path(a.plot).extension().string();
     if (ext != ".png" && ext != ".svg") throw SceneError("dicesim sweep", "--plot", a.plot, "must end in .png or .svg");
   }
+  // Before any toss: a sweep must not run every point and then fail to write.
+  check_output_path("dicesim sweep", "--csv", a.csv);
+  check_output_path("dicesim sweep", "--plot", a.plot);
+  check_output_path("dicesim sweep", "--markdown", a.markdown);
   const std::vector<ReferenceRow> seed_rows = spec.seed_table.empty() ? std::vector<ReferenceRow>{}
                                                                        : load_reference_table(spec.seed_table);
 
+  const InterruptGuard interrupt;  // Ctrl-C / SIGTERM: the points done are printed, exit 130
   ProgressBar bar;
   SweepRunOptions opt;
   opt.threads = a.threads;
+  opt.cancel = InterruptGuard::flag();
   opt.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
   std::unique_ptr<SweepOverLcm> lcm;
   if (a.distributed()) {
     std::string url = wire::resolve_url(a.lcm);
     if (a.lcm.empty() && url == wire::kDefaultUrl) url = private_lcm_url();
-    std::signal(SIGINT, on_stop_signal);
-    std::signal(SIGTERM, on_stop_signal);
-    lcm = std::make_unique<SweepOverLcm>(spec.scene, url, a.workers, &g_stop);
+    lcm = std::make_unique<SweepOverLcm>(spec.scene, url, a.workers, InterruptGuard::flag());
     opt.run_point = lcm->runner();
-    opt.cancel = &g_stop;
   }
   const SweepResult res = run_sweep(spec, opt);
   bar.finish();
   lcm.reset();  // stops the local workers
-  if (g_stop) {
-    std::fprintf(stderr, "dicesim: interrupted\n");
-    return kExitFailed;
-  }
+  const bool interrupted = InterruptGuard::interrupted();
+  const Provenance prov = sweep_provenance(spec, res, a.threads);
 
   if (!a.csv.empty()) {
-    if (a.csv == "-") std::fputs(csv_text(res).c_str(), stdout);
-    else write_text(a.csv, csv_text(res));
+    if (a.csv == "-") std::fputs(csv_text(res, prov).c_str(), stdout);
+    else write_text(a.csv, csv_text(res, prov));
   }
   if (!a.markdown.empty()) write_text(a.markdown, markdown_text(spec, res, seed_rows));
   if (!a.plot.empty()) write_plot(a.plot, spec, res, seed_rows, plot_labels(spec, a, file_mode));
   if (a.json)
-    std::printf("%s\n", json_report(spec, res, seed_rows, a.threads, a.workers).dump().c_str());
+    std::printf("%s\n", json_report(spec, res, seed_rows, a.threads, a.workers, prov).dump().c_str());
   else if (a.csv != "-")
-    std::fputs(table_text(spec, res, a.threads, a.workers).c_str(), stdout);
+    std::fputs(table_text(spec, res, a.threads, a.workers, prov).c_str(), stdout);
+  if (interrupted) {
+    std::fprintf(stderr, "dicesim: interrupted after %zu of %zu points\n", res.points.size(), spec.points.size());
+    return kExitInterrupted;
+  }
   return kExitOk;
 }
 

@@ -39,6 +39,8 @@ class Scene {
 
   // Loads the scene again with more overrides after its own (sweeps): as `--set` on the CLI.
   SceneDef load_with(const std::vector<std::string>& extra) const;
+  // The SHA-256 of the scene load_with(extra) loads (provenance: sim/scene/scene_hash.hpp).
+  std::string sha256_with(const std::vector<std::string>& extra) const;
 
  private:
   std::string origin_;

@@ -8,6 +8,7 @@
 #include "apps/power_report.hpp"
 #include "python/bindings.hpp"
 #include "sim/scene/scene_error.hpp"
+#include "sim/study/auto_pilot.hpp"
 
 namespace dicesim::py {
 namespace {
@@ -40,10 +41,18 @@ pb::object do_power(const pb::object& scene_given, const std::shared_ptr<Scene>&
   if (bootstrap < 100 || bootstrap > 1000000) throw pb::value_error("bootstrap must be in [100, 10^6], got " + std::to_string(bootstrap));
   if (!progress.is_none() && !PyCallable_Check(progress.ptr())) throw pb::type_error("progress must be callable or None");
 
-  const std::shared_ptr<const DieModel> model = scene.model(fidelity);
+  std::shared_ptr<const DieModel> model = scene.model(fidelity);
+  // auto: each scene's pilot at the study's simulated tosses (as `dicesim power`).
+  auto resolved = [&](std::shared_ptr<const DieModel> m) -> std::shared_ptr<const DieModel> {
+    if (m->fidelity_requested != Fidelity::Auto) return m;
+    auto r = std::make_shared<DieModel>(*m);
+    resolve_auto(*r, precision_of_run(*r, n), resolve_threads(threads));
+    return r;
+  };
+  model = resolved(model);
   std::shared_ptr<const DieModel> other;
   if (against) {
-    other = against->model(fidelity);
+    other = resolved(against->model(fidelity));
     if (other->outcome_labels != model->outcome_labels)
       throw SceneError(against->origin(), "outcome labels", labels_text(other->outcome_labels),
                        "must equal those of " + scene.origin() + " " + labels_text(model->outcome_labels) +
@@ -58,6 +67,13 @@ pb::object do_power(const pb::object& scene_given, const std::shared_ptr<Scene>&
   }
   info.seed = seed;
   info.threads = resolve_threads(threads);
+  {
+    const std::vector<std::string> extra = fidelity_override(fidelity);
+    std::vector<std::string> overrides = scene.overrides();
+    overrides.insert(overrides.end(), extra.begin(), extra.end());
+    info.provenance = make_provenance(scene.origin(), overrides, scene.sha256_with(extra), *model, seed, n, info.threads);
+    if (against) info.against_sha256 = against->sha256_with(extra);
+  }
   PowerStudyConfig& cfg = info.config;
   cfg.tosses = n;
   cfg.seed = seed;

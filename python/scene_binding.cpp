@@ -4,11 +4,14 @@
 
 #include <pybind11/stl.h>
 
+#include "sim/scene/scene_hash.hpp"
 #include "apps/info_json.hpp"
+#include "apps/report.hpp"
 #include "python/bindings.hpp"
 #include "sim/scene/fidelity.hpp"
 #include "sim/scene/scene_error.hpp"
 #include "sim/body/material_parts.hpp"
+#include "sim/study/auto_pilot.hpp"
 #include "sim/models/compile.hpp"
 
 namespace dicesim::py {
@@ -115,6 +118,12 @@ std::shared_ptr<Scene> Scene::from_text(std::string text, std::string origin, st
   return s;
 }
 
+std::string Scene::sha256_with(const std::vector<std::string>& extra) const {
+  std::vector<std::string> all = overrides_;
+  all.insert(all.end(), extra.begin(), extra.end());
+  return text_ ? scene_text_sha256(*text_, origin_, all) : scene_sha256(origin_, all);
+}
+
 SceneDef Scene::load_with(const std::vector<std::string>& extra) const {
   std::vector<std::string> all = overrides_;
   all.insert(all.end(), extra.begin(), extra.end());
@@ -149,7 +158,13 @@ void register_scene(pb::module_& m) {
           "The outcome labels: distinct face labels, ascending (the order of Result.counts).")
       .def(
           "info",
-          [](Scene& s, std::optional<std::string> fidelity) { return json_to_python(info_json(s.origin(), *s.model(fidelity), material_parts(s.def(), s.origin())));
+          [](Scene& s, std::optional<std::string> fidelity) {
+            DieModel m = *s.model(fidelity);
+            const FidelityPilot pilot = resolve_auto(m, precision_of_run(m, 100000), resolve_threads(0));  // as `dicesim info`
+            nlohmann::json j = info_json(s.origin(), m, material_parts(s.def(), s.origin()));
+            j["pilot"] = pilot_json(pilot);
+            if (j["pilot"].is_object()) j["pilot"].erase("seconds");  // as `dicesim info --json`
+            return json_to_python(j);
           },
           pb::arg("fidelity") = pb::none(),
           "What the scene compiles to, as a dict: exactly `dicesim info SCENE --json`'s object (mass,\n"

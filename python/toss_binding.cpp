@@ -9,6 +9,7 @@
 #include "aggregator/target.hpp"
 #include "apps/report.hpp"
 #include "python/bindings.hpp"
+#include "sim/study/auto_pilot.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/study/monte_carlo.hpp"
 #include "sim/study/sweep.hpp"
@@ -78,9 +79,14 @@ class Result {
   std::optional<nlohmann::json> json_;
 };
 
+// `extra`: the overrides after the scene's own (fidelity=, a sweep point's key): with them the
+// scene is loaded again for its provenance (the resolved scene's hash), as the CLI reports it.
 RunReport make_report(const Scene& scene, const DieModel& model, std::uint64_t seed, int threads, std::uint64_t tosses,
-                      const RunCounts& counts, double elapsed_s) {
+                      const RunCounts& counts, double elapsed_s, const std::vector<std::string>& extra) {
   RunReport r;
+  std::vector<std::string> overrides = scene.overrides();
+  overrides.insert(overrides.end(), extra.begin(), extra.end());
+  r.provenance = make_provenance(scene.origin(), overrides, scene.sha256_with(extra), model, seed, tosses, threads);
   r.scene = scene.origin();
   r.fidelity = to_string(model.fidelity);
   r.seed = seed;
@@ -136,7 +142,16 @@ Result do_toss(const pb::object& scene_given, const pb::object& n_given, std::ui
     throw pb::value_error("target_halfwidth must be in [1e-6, 0.5], got " + std::to_string(*target_halfwidth));
   if (!progress.is_none() && !PyCallable_Check(progress.ptr())) throw pb::type_error("progress must be callable or None");
   const int nthreads = resolve_threads(threads);
-  const std::shared_ptr<const DieModel> model = scene.model(fidelity);
+  std::shared_ptr<const DieModel> model = scene.model(fidelity);
+  FidelityPilot pilot;
+  if (model->fidelity_requested == Fidelity::Auto) {  // auto: the pilot at this call's precision (as `dicesim toss`)
+    auto resolved = std::make_shared<DieModel>(*model);
+    pb::gil_scoped_release nogil;
+    pilot = resolve_auto(*resolved, target_halfwidth ? precision_of_target(*resolved, *target_halfwidth)
+                                             : precision_of_run(*resolved, n.value_or(100000)),
+                 nthreads);
+    model = std::move(resolved);
+  }
 
   RunConfig cfg;
   cfg.seed = seed;
@@ -166,7 +181,10 @@ Result do_toss(const pb::object& scene_given, const pb::object& n_given, std::ui
         monitor, progress);
   }
   const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
-  return Result(make_report(scene, *model, seed, nthreads, done, counts, elapsed));
+  RunReport rep = make_report(scene, *model, seed, nthreads, done, counts, elapsed, fidelity_override(fidelity));
+  rep.provenance.tosses = tosses;  // asked for (with a target: the cap), as the CLI's
+  rep.pilot = pilot;
+  return Result(std::move(rep));
 }
 
 // A sweep: one Result per value, every point tossed with the same seed and indices 0..n-1.
@@ -201,7 +219,11 @@ Sweep run_points(Scene& scene, Sweep out, std::uint64_t n, std::uint64_t seed, i
   if (out.values.empty()) throw pb::value_error("values is empty");
   const int nthreads = resolve_threads(threads);
   std::vector<DieModel> models;
-  for (const std::vector<std::string>& extra : out.overrides) models.push_back(compile(scene.load_with(extra), scene.origin()));
+  std::vector<FidelityPilot> pilots;
+  for (const std::vector<std::string>& extra : out.overrides) {
+    models.push_back(compile(scene.load_with(extra), scene.origin()));
+    pilots.push_back(resolve_auto(models.back(), precision_of_run(models.back(), n), nthreads));  // auto: per point, as `dicesim sweep`
+  }
 
   RunMonitor monitor;
   monitor.total = n * models.size();
@@ -225,7 +247,11 @@ Sweep run_points(Scene& scene, Sweep out, std::uint64_t n, std::uint64_t seed, i
       monitor, progress);
   out.elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
   for (std::size_t i = 0; i < models.size(); ++i)
-    out.points.push_back(std::make_shared<Result>(make_report(scene, models[i], seed, nthreads, n, counts[i], elapsed[i])));
+  {
+    RunReport report = make_report(scene, models[i], seed, nthreads, n, counts[i], elapsed[i], out.overrides[i]);
+    report.pilot = pilots[i];
+    out.points.push_back(std::make_shared<Result>(std::move(report)));
+  }
   return out;
 }
 

@@ -19,6 +19,7 @@
 #include <toml++/toml.h>
 
 #include "sim/scene/scene_error.hpp"
+#include "sim/scene/scene_hash.hpp"
 
 namespace dicesim {
 namespace {
@@ -560,6 +561,7 @@ void read_sim(Reader sim, SimDef& def) {
 
 SceneDef build(const toml::table& tree, const std::string& origin, const std::string& default_name) {
   SceneDef s = default_scene_def();
+  s.sim.fidelity = Fidelity::Auto;  // a scene file that names no model gets the measured choice (issue 35)
   Reader top(&tree, "", origin);
   s.name = top.string("name").value_or(default_name);
   if (s.name.empty()) top.fail(top.get("name"), "name", "must be a non-empty string");
@@ -777,6 +779,13 @@ std::string stem_or(const std::string& path, const std::string& fallback) {
   return stem.empty() ? fallback : stem;
 }
 
+// The resolved tree's hash (scene_hash.hpp); build() validates it and reads a mesh's OBJ.
+std::string tree_sha256(toml::table tree, const std::string& origin, const std::vector<std::string>& overrides) {
+  for (const std::string& o : overrides) apply_override(tree, o, origin);
+  const SceneDef def = build(tree, origin, stem_or(origin, "scene"));
+  return sha256_hex(canonical_scene_text(tree, def.die.mesh_text));
+}
+
 SceneDef finish_tree(toml::table tree, const std::string& origin, const std::vector<std::string>& overrides) {
   for (const std::string& o : overrides) apply_override(tree, o, origin);
   return build(tree, origin, stem_or(origin, "scene"));
@@ -796,6 +805,17 @@ SceneDef parse_scene(const std::string& toml_text, const std::string& origin, co
   std::vector<ChainLink> chain;
   toml::table tree = resolve_extends(parse_toml(toml_text, origin), origin, fs::current_path(), chain);
   return finish_tree(std::move(tree), origin, overrides);
+}
+
+std::string scene_sha256(const std::string& path, const std::vector<std::string>& overrides) {
+  std::vector<ChainLink> chain;
+  if (fs::is_regular_file(path)) chain.push_back({fs::weakly_canonical(path), fs::path(path)});
+  return tree_sha256(load_tree(path, chain), path, overrides);
+}
+
+std::string scene_text_sha256(const std::string& toml_text, const std::string& origin, const std::vector<std::string>& overrides) {
+  std::vector<ChainLink> chain;
+  return tree_sha256(resolve_extends(parse_toml(toml_text, origin), origin, fs::current_path(), chain), origin, overrides);
 }
 
 }  // namespace dicesim

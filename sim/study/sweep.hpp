@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/study/auto_pilot.hpp"
 #include "sim/study/monte_carlo.hpp"
 #include "sim/study/statistics.hpp"
 
@@ -89,10 +90,16 @@ struct SweepPointResult {
   RunCounts counts;
   std::vector<int> labels;  // the model's outcome labels (counts.faces in this order)
   std::string fidelity;
+  std::string fidelity_reason;  // why (auto: each point's own pilot, at the sweep's tosses per point)
+  FidelityPilot pilot;
+  std::string scene_sha256;     // the point's fully resolved scene (sim/scene/scene_hash.hpp)
+  // Cancelled during this point (in-process only): counts are the complete prefix 0..k-1 of its
+  // tosses (k = counts.total() < tosses), the same as a point of k tosses.
+  bool partial = false;
 };
 
 struct SweepResult {
-  std::vector<SweepPointResult> points;
+  std::vector<SweepPointResult> points;  // those done, in order (a cancelled sweep: a prefix of the points)
   double elapsed_s = 0.0;
 };
 
