@@ -66,6 +66,10 @@ int parse_and_run(CLI::App& app, int argc, char** argv, const int& exit_code) {
   return exit_code;
 }
 
+// The browser commands (web/): declared here, not in commands.hpp, which every command includes.
+void register_show(CLI::App& app, int& exit_code);   // cmd_show.cpp
+void register_serve(CLI::App& app, int& exit_code);  // cmd_serve.cpp
+
 int run_cli(int argc, char** argv) {
   // `dicesim bench tradeoff SCENE` lives next to `dicesim bench SCENE` (whose SCENE is positional).
   if (argc >= 3 && std::string_view(argv[1]) == "bench" && std::string_view(argv[2]) == "tradeoff")
@@ -97,6 +101,8 @@ int run_cli(int argc, char** argv) {
   register_watch(app, exit_code);
   register_record(app, exit_code);
   register_replay(app, exit_code);
+  register_show(app, exit_code);
+  register_serve(app, exit_code);
   return parse_and_run(app, argc, argv, exit_code);
 }
 
