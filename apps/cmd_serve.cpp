@@ -1,5 +1,6 @@
 // dicesim serve: a local web page following the live run on the LCM bus (web/).
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <thread>

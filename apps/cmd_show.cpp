@@ -1,5 +1,6 @@
 // dicesim show: the die (and one toss) as a self-contained HTML page (web/).
 #include <cerrno>
+#include <stdexcept>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>

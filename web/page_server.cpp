@@ -5,7 +5,11 @@
 #include <chrono>
 #include <thread>
 
+#include <arpa/inet.h>
 #include <httplib.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include "web/assets.hpp"
 
@@ -62,7 +66,37 @@ PageServer::PageServer(const LiveBoard& board) : impl_(std::make_unique<Impl>())
 
 PageServer::~PageServer() { stop(); }
 
+namespace {
+
+// cpp-httplib binds with SO_REUSEPORT, so a second server on a port in use would bind as well and
+// share it. A plain socket cannot: bound and closed first, it tells whether the port is free.
+bool port_free(const std::string& addr, int port) {
+  sockaddr_in v4{};
+  sockaddr_in6 v6{};
+  const bool is4 = inet_pton(AF_INET, addr.c_str(), &v4.sin_addr) == 1;
+  if (!is4 && inet_pton(AF_INET6, addr.c_str(), &v6.sin6_addr) != 1) return true;  // a name: httplib resolves it
+  const int fd = ::socket(is4 ? AF_INET : AF_INET6, SOCK_STREAM, 0);
+  if (fd < 0) return true;
+  const int one = 1;  // a port left in TIME_WAIT by an earlier server is free (only a listener is not)
+  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+  int ok;
+  if (is4) {
+    v4.sin_family = AF_INET;
+    v4.sin_port = htons(static_cast<std::uint16_t>(port));
+    ok = ::bind(fd, reinterpret_cast<const sockaddr*>(&v4), sizeof v4);
+  } else {
+    v6.sin6_family = AF_INET6;
+    v6.sin6_port = htons(static_cast<std::uint16_t>(port));
+    ok = ::bind(fd, reinterpret_cast<const sockaddr*>(&v6), sizeof v6);
+  }
+  ::close(fd);
+  return ok == 0;
+}
+
+}  // namespace
+
 bool PageServer::bind(const std::string& addr, int port) {
+  if (port != 0 && !port_free(addr, port)) return false;
   if (port == 0) {
     impl_->port = impl_->http.bind_to_any_port(addr);
     return impl_->port > 0;

@@ -68,7 +68,8 @@
   const faceMeshes = [];
   const translucent = die.regions.length > 0;
 
-  function labelTexture(text, px, fontFrac, color) {
+  // fontFrac: font size over the texture's side; fitFrac: the widest the text may be (same units).
+  function labelTexture(text, px, fontFrac, color, fitFrac) {
     const c = document.createElement('canvas');
     c.width = c.height = px;
     const g = c.getContext('2d');
@@ -79,7 +80,8 @@
     let size = px * fontFrac;
     g.font = 'bold ' + size + 'px sans-serif';
     const w = g.measureText(t).width;
-    if (w > px * 0.8) { size *= px * 0.8 / w; g.font = 'bold ' + size + 'px sans-serif'; }
+    const fit = px * (fitFrac || 0.8);
+    if (w > fit) { size *= fit / w; g.font = 'bold ' + size + 'px sans-serif'; }
     g.textAlign = 'center';
     g.textBaseline = 'middle';
     g.fillText(t, px / 2, px / 2);
@@ -132,7 +134,8 @@
       const up = Math.abs(n.z) < 0.9 ? new THREE.Vector3(0, 0, 1).sub(n.clone().multiplyScalar(n.z)).normalize() : e2;
       const right = up.clone().cross(n).normalize();
       const uvOf = (p) => { const d = p.clone().sub(centre); return [0.5 + d.dot(right) / (2 * half), 0.5 + d.dot(up) / (2 * half)]; };
-      const mat = faceMaterial(labelTexture(f.text, 256, Math.min(0.6, 0.95 * inr / half), '#efe9d6'));
+      // The label inside the face's inscribed circle (diameter inr / half of the texture's side).
+      const mat = faceMaterial(labelTexture(f.text, 256, Math.min(0.6, 0.62 * inr / half), '#efe9d6', 0.85 * inr / half));
       const mesh = new THREE.Mesh(polygonGeometry(pts, uvOf), mat);
       body.add(mesh);
       faceMeshes.push({ mesh: mesh, materials: [mat] });

@@ -48,7 +48,8 @@ def test_show_toss_is_toss_one(dicesim, die1, fidelity):
     assert frames[k][1:4] == pytest.approx(list(t["impacts"]["before"]["position"][0]), abs=1e-7)
     # Dense enough to animate: no gap over 1 ms outside the stretches of sustained contact.
     inside = lambda a, b: any(lo - 1e-9 <= a and b <= hi + 1e-9 for lo, hi in toss["interpolated"])
-    assert max(b - a for a, b in zip(times, times[1:]) if not inside(a, b)) <= 1e-3 + 1e-9
+    # (times are written to 7 significant digits: 1e-6 s of rounding at t ~ 1 s)
+    assert max(b - a for a, b in zip(times, times[1:]) if not inside(a, b)) <= 1e-3 + 2e-6
     if fidelity == "paper":
         assert toss["interpolated"] == []
 
