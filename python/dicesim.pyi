@@ -1,4 +1,5 @@
 """Type stubs of the dicesim extension module (python/*.cpp). Docstrings: help(dicesim)."""
+import os
 from typing import Any, Callable, Iterable, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -10,6 +11,10 @@ __version__: str
 SetValue = Union[bool, int, float, str, Sequence[Any]]
 Overrides = Union[Mapping[str, SetValue], Iterable[str], None]
 Progress = Optional[Callable[[int, int], Any]]
+# A scene argument: a loaded Scene, or a path to load (as load_scene(path)).
+SceneArg = Union["Scene", str, os.PathLike[str]]
+# A count: an int, or a float that is a whole number (1e5).
+Count = Union[int, float]
 
 class SceneError(ValueError):
     """Bad scene input; str(e) is the CLI's exit-2 message."""
@@ -87,8 +92,8 @@ class Sweep:
 def load_scene(path: str, set: Overrides = None) -> Scene: ...
 def scene_from_toml(text: str, set: Overrides = None, name: str = "<string>") -> Scene: ...
 def toss(
-    scene: Scene,
-    n: Optional[int] = None,
+    scene: SceneArg,
+    n: Optional[Count] = None,
     seed: int = 1,
     threads: int = 0,
     fidelity: Optional[str] = None,
@@ -105,10 +110,10 @@ class ShowPage:
 
 def show(scene: Scene, toss: Optional[int] = None, seed: int = 1, fidelity: Optional[str] = None) -> ShowPage: ...
 def sweep(
-    scene: Scene,
+    scene: SceneArg,
     key: str,
     values: Union[str, Iterable[float]],
-    n: int,
+    n: Count,
     seed: int = 1,
     threads: int = 0,
     fidelity: Optional[str] = None,
@@ -119,7 +124,7 @@ def sweep(
 ) -> Sweep: ...
 def sweep_file(
     path: str,
-    n: Optional[int] = None,
+    n: Optional[Count] = None,
     seed: Optional[int] = None,
     threads: int = 0,
     fidelity: Optional[str] = None,
@@ -129,7 +134,7 @@ def fit(
     scene: Union[Scene, str, Sequence[Union[Scene, str]]],
     data: Union[str, Mapping[int, int], Sequence[Union[str, Mapping[int, int]]]],
     params: Union[Mapping[str, Tuple[float, float]], Sequence[str]],
-    n: int = 0,
+    n: Count = 0,
     rounds: int = 3,
     seed: int = 1,
     threads: int = 0,
@@ -137,11 +142,11 @@ def fit(
     progress: Progress = None,
 ) -> dict[str, Any]: ...
 def power(
-    scene: Scene,
+    scene: SceneArg,
     *,
     against: Optional[Scene] = None,
     detect_bias: Optional[float] = None,
-    n: int = 100000,
+    n: Count = 100000,
     alpha: float = 0.05,
     power: float = 0.8,
     replicates: int = 4000,
