@@ -83,6 +83,10 @@ int parse_and_run(CLI::App& app, int argc, char** argv, const int& exit_code) {
   return exit_code;
 }
 
+// The browser commands (web/): declared here, not in commands.hpp, which every command includes.
+void register_show(CLI::App& app, int& exit_code);   // cmd_show.cpp
+void register_serve(CLI::App& app, int& exit_code);  // cmd_serve.cpp
+
 namespace {
 
 // Edits (insert, delete, replace, swap of neighbours) from a to b: how far a typo is from a command.
@@ -152,6 +156,8 @@ int run_cli(int argc, char** argv) {
   register_watch(app, exit_code);
   register_record(app, exit_code);
   register_replay(app, exit_code);
+  register_show(app, exit_code);
+  register_serve(app, exit_code);
   register_version(app, exit_code);
   app.set_version_flag("--version", std::string("dicesim ") + git_describe(), "Print the version and exit (dicesim version: the build)");
   accept_number_forms(app);

@@ -11,6 +11,8 @@
 
 namespace dicesim::py {
 
+void register_show(pb::module_& m);  // show_binding.cpp
+
 int resolve_threads(int threads) {
   if (threads < 0) throw pb::value_error("threads must be >= 0 (0: all cores), got " + std::to_string(threads));
   if (threads > 1024) throw pb::value_error("threads must be <= 1024, got " + std::to_string(threads));
@@ -70,7 +72,7 @@ PYBIND11_MODULE(dicesim, m) {
       "    r = dicesim.toss(scene, 100_000)\n"
       "    r.labels, r.counts, r.p, r.ci95    # numpy arrays, faces by label\n"
       "    r.to_dict()                        # exactly `dicesim toss --json`'s object\n\n"
-      "Functions: load_scene, scene_from_toml, toss, toss_one, sweep, sweep_file, fit, power. Bad scene\n"
+      "Functions: load_scene, scene_from_toml, toss, toss_one, show, sweep, sweep_file, fit, power. Bad scene\n"
       "input raises SceneError (a ValueError) with the message the command line prints.";
   m.attr("__version__") = "0.1.0";
 
@@ -96,6 +98,7 @@ PYBIND11_MODULE(dicesim, m) {
   py::register_scene(m);
   py::register_toss(m);
   py::register_trace(m);
+  py::register_show(m);
   py::register_fit(m);
   py::register_power(m);
 }

@@ -1,0 +1,148 @@
+#!/usr/bin/env bash
+# `dicesim show` pages in a real browser: headless Chromium (Debian's `chromium`), inside a private
+# network namespace (private_net.sh: only loopback), so the page can reach nothing. Run by CTest:
+#   browser.sh DICESIM_BINARY SCENARIO
+# Scenarios:
+#   show_die   the loaded d20 without a toss: the page loads with no console error, requests no URL
+#              but its own file, the canvas has the die drawn (many pixels off the background, the
+#              steel region's orange among them) and the info table is in the page text.
+#   show_toss  a d20 `impulse` toss opened at its end (#t=end): the same checks, the face read drawn
+#              highlighted (gold pixels on the canvas) and the outcome `show` printed in the page text.
+#   serve      `dicesim serve` during a `dicesim run` on the same bus: a second serve on the same
+#              port is exit 2; once the run ends, /state and the last server-sent event (curl of the
+#              stream) show the run's final counts and probabilities.
+# Screenshots are kept in $DICESIM_BROWSER_SHOTS when that is set (to look at them).
+set -euo pipefail
+
+. "$(dirname "$0")/private_net.sh" browser "$@"
+
+bin=$1 scenario=$2
+command -v chromium > /dev/null || skip "chromium is not installed (scripts/setup installs it)"
+fail() { echo "FAIL [$scenario]: $*" >&2; exit 1; }
+
+serve_scenario() {
+  local port=18037
+  "$bin" serve --port $port > "$work/serve.out" 2> "$work/serve.err" & pids+=($!)
+  for _ in $(seq 100); do curl -sf "http://127.0.0.1:$port/state" > /dev/null && break; sleep 0.1; done
+  curl -sf "http://127.0.0.1:$port/state" > /dev/null || { cat "$work/serve.err" >&2; fail "serve did not start"; }
+  # A port in use: exit 2, the port named, nothing on stdout.
+  set +e
+  "$bin" serve --port $port > "$work/busy.out" 2> "$work/busy.err"
+  rc=$?
+  set -e
+  [ $rc -eq 2 ] || fail "serve on a busy port exited $rc, expected 2"
+  grep -q "127.0.0.1:$port" "$work/busy.err" || fail "the busy port is not named: $(cat "$work/busy.err")"
+  [ ! -s "$work/busy.out" ] || fail "serve on a busy port wrote to stdout"
+  curl -sN "http://127.0.0.1:$port/events" > "$work/events.txt" & pids+=($!)
+  # run's own URL unless told: the bus serve listens on.
+  "$bin" run scenes/paper/die1.toml --workers 2 --tosses 300000 --seed 11 --json --lcm "$LCM_DEFAULT_URL" > "$work/run.json" 2> "$work/run.err" ||
+    { tail "$work/run.err" >&2; fail "run exited $?"; }
+  sleep 1.5  # the final answer reaches serve and its event stream
+  curl -sf "http://127.0.0.1:$port/state" > "$work/state.json"
+  /usr/bin/python3 - "$work/run.json" "$work/state.json" "$work/events.txt" <<'PY' || fail "the served page does not show the run's final answer"
+import json, re, sys
+run = json.load(open(sys.argv[1]))
+counts = {f["face"]: f["count"] for f in run["faces"]}
+ps = {f["face"]: f["p"] for f in run["faces"]}
+state = json.load(open(sys.argv[2]))["run"]
+assert state["finished"], "the run is not finished in /state"
+assert dict(zip(state["labels"], state["counts"])) == counts, (state["counts"], counts)
+for label, p in zip(state["labels"], state["p"]):
+    assert abs(p - ps[label]) <= 1e-12, (label, p, ps[label])
+events = [json.loads(l[6:]) for l in open(sys.argv[3]) if l.startswith("data: ")]
+assert len(events) >= 2, "fewer than two server-sent events"
+last = events[-1]["run"]
+assert last["finished"] and dict(zip(last["labels"], last["counts"])) == counts, "the last event is not the final answer"
+print(f"served: {len(events)} events; final counts {counts} on /state and the event stream")
+PY
+  echo "PASS [$scenario]"
+  exit 0
+}
+
+case "$scenario" in
+  serve) serve_scenario ;;
+  show_die) scene=scenes/dice/loaded-d20.toml; args=(); hash="" ;;
+  show_toss) scene=scenes/dice/d20.toml; args=(--fidelity impulse --toss 7); hash="#t=end" ;;
+  *) fail "unknown scenario" ;;
+esac
+page=$work/page.html
+"$bin" show "$scene" "${args[@]}" -o "$page" 2> "$work/show.err" || { cat "$work/show.err" >&2; fail "show exited $?"; }
+cat "$work/show.err"
+
+# One browser run: software WebGL (SwiftShader), no background traffic, a net log of every request.
+browse() {
+  local what=$1; shift
+  timeout 90 chromium --headless=new --no-sandbox --disable-gpu --use-angle=swiftshader --enable-unsafe-swiftshader \
+    --no-first-run --no-default-browser-check --disable-background-networking --disable-component-update \
+    --disable-sync --disable-extensions --user-data-dir="$work/profile-$what" --window-size=1280,800 \
+    --enable-logging=stderr --v=0 --log-net-log="$work/net-$what.json" --virtual-time-budget=4000 \
+    "$@" "file://$page$hash" > "$work/$what.out" 2> "$work/$what.err" || { tail -20 "$work/$what.err" >&2; fail "chromium ($what) exited $?"; }
+}
+browse shot --screenshot="$work/shot.png"
+browse dom --dump-dom
+
+# No console error or uncaught exception (Chromium logs the page's console as CONSOLE lines).
+if grep -E 'CONSOLE|Uncaught' "$work/shot.err" "$work/dom.err" | grep -viE '"(log|info|debug)"' | grep -iE 'error|uncaught'; then
+  fail "the page logged an error"
+fi
+grep -E 'CONSOLE' "$work/shot.err" "$work/dom.err" || true
+
+# Requests: every URL the page asked for is the page itself (or inline: data:, blob:). Chromium's
+# own background requests (component updates, network time; initiator "not an origin") fail in
+# the namespace and are not the page's.
+/usr/bin/python3 - "file://$page" "$work/net-shot.json" "$work/net-dom.json" <<'PY' || fail "the page requested something outside its file"
+import json, sys
+page = sys.argv[1]
+bad, own = set(), set()
+for path in sys.argv[2:]:
+    d = json.load(open(path))
+    names = {v: k for k, v in d["constants"]["logEventTypes"].items()}
+    for e in d["events"]:
+        p = e.get("params", {})
+        if names.get(e["type"]) != "URL_REQUEST_START_JOB" or "url" not in p:
+            continue
+        url = p["url"]
+        if p.get("initiator") == "not an origin":
+            own.add(url.split("?")[0])
+        elif url.split("#")[0] != page and not url.startswith(("data:", "blob:")):
+            bad.add(url)
+print(f"requests: none by the page; {len(own)} of the browser's own (ignored)")
+for u in sorted(bad):
+    print("the page requested:", u)
+sys.exit(1 if bad else 0)
+PY
+
+# The page text: the info table, and the toss's outcome as `show` named it.
+grep -q 'principal moments' "$work/dom.out" || fail "no info table in the page text"
+if [ "$scenario" = show_toss ]; then
+  outcome=$(sed -nE 's/.*outcome ([0-9a-z/]+), .*/\1/p' "$work/show.err")
+  [ -n "$outcome" ] || fail "show printed no outcome"
+  grep -q "id=\"outcome-label\">$outcome<" "$work/dom.out" || fail "outcome $outcome is not in the page text"
+  grep -q 'class="m ' "$work/dom.out" || fail "no impact marked on the timeline"
+fi
+
+# The canvas: the die drawn (pixels of the 3-D view that are not its background).
+[ -s "$work/shot.png" ] || fail "no screenshot"
+if [ -n "${DICESIM_BROWSER_SHOTS:-}" ]; then mkdir -p "$DICESIM_BROWSER_SHOTS"; cp "$work/shot.png" "$DICESIM_BROWSER_SHOTS/$scenario.png"; fi
+/usr/bin/python3 - "$work/shot.png" "$scenario" <<'PY' || fail "the die is not drawn in the screenshot"
+import sys
+from PIL import Image
+img = Image.open(sys.argv[1]).convert("RGB")
+w, h = img.size
+view = img.crop((0, 0, int(w * 0.55), h))  # the 3-D view is the left 60 % of the page
+px = list(view.getdata())
+bg = (0xf4, 0xf4, 0xf1)
+off = sum(1 for p in px if sum(abs(a - b) for a, b in zip(p, bg)) > 30)
+dark = sum(1 for p in px if max(p) < 80)  # label digits
+gold = sum(1 for p in px if p[0] > 200 and p[1] > 190 and p[2] < 150 and p[0] - p[2] > 90)  # the face read (yellow)
+orange = sum(1 for p in px if p[0] > 170 and 90 < p[1] < 190 and p[2] < 140 and p[0] - p[1] > 50)  # a steel region
+n = len(px)
+print(f"{w}x{h}: {off / n:.1%} of the view off the background, {dark} dark, {gold} gold, {orange} orange pixels")
+ok = off > 0.02 * n and dark > 50
+if sys.argv[2] == "show_toss":
+    ok = ok and gold > 100
+else:
+    ok = ok and orange > 100
+sys.exit(0 if ok else 1)
+PY
+echo "PASS [$scenario]"

@@ -1,0 +1,53 @@
+// What `dicesim serve`'s page shows, fed from the bus: the aggregator's latest answer per run
+// (DICESIM_PROBABILITIES) and the workers' heartbeats (DICESIM_WORKER_STATUS), as one JSON state
+// with a version that changes on every update. Thread-safe: the bus thread feeds it, the HTTP
+// threads read it and wait for changes.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "messages/auth.hpp"
+
+namespace dicesim::web {
+
+class LiveBoard {
+ public:
+  // key: a run key (messages/auth.hpp): only messages whose seal opens count; empty: none.
+  explicit LiveBoard(const std::vector<std::uint8_t>& key = {});
+
+  // One message as heard on `channel` (sealed bytes). Others' channels are ignored.
+  void handle(const std::string& channel, const void* data, std::size_t len);
+
+  // The state as JSON text, and its version (0 before anything was heard):
+  // {"version", "run": {run_id, labels, counts, p, ci_lo, ci_hi, settled, unresolved, invalid, done,
+  //  total, tosses_per_s, eta_s, finished, workers, duplicates, rejected_foreign, rejected_malformed,
+  //  rejected_range, rejected_unauthenticated, released} or null, "workers": [{id, host, pid, state,
+  //  error, tosses_done, tosses_per_s, age_s, health: "ok"|"late"|"silent"}],
+  //  "heard": {unauthenticated, malformed} (what this server could not open or decode)}.
+  std::string json(std::uint64_t* version = nullptr) const;
+  // Waits until the version differs from `seen` or `timeout` passes; returns the version.
+  std::uint64_t wait(std::uint64_t seen, std::chrono::milliseconds timeout) const;
+
+ private:
+  struct Worker {
+    nlohmann::json last;
+    std::chrono::steady_clock::time_point heard;
+  };
+  mutable std::mutex mu_;
+  mutable std::condition_variable changed_;
+  wire::Sealer sealer_;
+  std::uint64_t version_ = 0;
+  nlohmann::json run_;  // the latest answer (of the latest run heard)
+  std::map<std::int64_t, Worker> workers_;
+  std::uint64_t unauthenticated_ = 0, malformed_ = 0;
+};
+
+}  // namespace dicesim::web

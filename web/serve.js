@@ -1,0 +1,54 @@
+// dicesim serve: the live run, updated in place from the server-sent events at /events.
+(function () {
+  'use strict';
+  const $ = (id) => document.getElementById(id);
+  const esc = (s) => String(s).replace(/[&<>"]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' })[c]);
+  const dur = (s) => (s >= 3600 ? (s / 3600).toFixed(1) + ' h' : s >= 60 ? (s / 60).toFixed(1) + ' min' : s.toFixed(1) + ' s');
+  let bars = [];  // one element per outcome, kept (updated in place)
+  function render(state) {
+    const r = state.run;
+    if (r) {
+      $('status').textContent = 'run ' + r.run_id + (r.finished ? ': finished' : ': running');
+      $('status').className = r.finished ? 'finished' : 'running';
+      const frac = r.total > 0 ? r.done / r.total : 0;
+      $('progress').style.width = (100 * frac).toFixed(2) + '%';
+      $('numbers').innerHTML = esc(r.done.toLocaleString('en')) + ' / ' + esc(r.total.toLocaleString('en')) + ' tosses (' +
+        (100 * frac).toFixed(1) + ' %) &middot; ' + Math.round(r.tosses_per_s).toLocaleString('en') + ' tosses/s &middot; ' +
+        (r.finished ? 'done' : 'ETA ' + dur(r.eta_s)) + ' &middot; ' + r.workers + ' workers &middot; settled ' + r.settled +
+        ', unresolved ' + r.unresolved + ', invalid ' + r.invalid;
+      if (bars.length !== r.labels.length) {
+        $('bars').innerHTML = '';
+        bars = r.labels.map(() => {
+          const row = document.createElement('div');
+          row.className = 'bar';
+          row.innerHTML = '<span class="name"></span><span class="track"><span class="fill"></span><span class="ci"></span></span><span class="num"></span>';
+          $('bars').appendChild(row);
+          return row;
+        });
+      }
+      const top = Math.max(1e-9, ...r.ci_hi);
+      r.labels.forEach((label, i) => {
+        const row = bars[i];
+        row.querySelector('.name').textContent = label;
+        row.querySelector('.fill').style.width = (100 * r.p[i] / top) + '%';
+        const ci = row.querySelector('.ci');
+        ci.style.left = (100 * r.ci_lo[i] / top) + '%';
+        ci.style.width = (100 * (r.ci_hi[i] - r.ci_lo[i]) / top) + '%';
+        row.querySelector('.num').innerHTML = '<span class="p" data-label="' + label + '">' + r.p[i].toFixed(5) + '</span> [' +
+          r.ci_lo[i].toFixed(4) + ', ' + r.ci_hi[i].toFixed(4) + '] <span class="count">' + r.counts[i] + '</span>';
+      });
+      $('health').innerHTML = [['duplicates', r.duplicates], ['released (lost batches, expired leases)', r.released],
+        ['rejected: another run', r.rejected_foreign], ['rejected: malformed', r.rejected_malformed],
+        ['rejected: index out of range', r.rejected_range], ['rejected: unauthenticated', r.rejected_unauthenticated],
+        ['heard here, unauthenticated', state.heard.unauthenticated], ['heard here, undecodable', state.heard.malformed]]
+        .map((x) => '<tr><td>' + esc(x[0]) + '</td><td>' + x[1] + '</td></tr>').join('');
+    }
+    $('workers').innerHTML = '<tr><th>worker</th><th>host</th><th>pid</th><th>state</th><th>tosses</th><th>tosses/s</th><th>last heard</th></tr>' +
+      state.workers.map((w) => '<tr><td>' + esc(w.id.toString(16)) + '</td><td>' + esc(w.host) + '</td><td>' + w.pid + '</td><td>' + esc(w.state) +
+        (w.error ? ': ' + esc(w.error) : '') + '</td><td>' + w.tosses_done + '</td><td>' + Math.round(w.tosses_per_s) +
+        '</td><td class="' + w.health + '">' + w.age_s.toFixed(1) + ' s ago (' + w.health + ')</td></tr>').join('');
+  }
+  const source = new EventSource('events');
+  source.onmessage = (e) => { render(JSON.parse(e.data)); $('conn').textContent = 'connected: updates as the aggregator answers'; };
+  source.onerror = () => { $('conn').textContent = 'connection to dicesim serve lost; retrying (the last state stays shown)'; };
+})();
