@@ -830,6 +830,7 @@ TEST(CylinderImpulse, SupportSearchesOutOfIterationsAreCounted) {
   EXPECT_EQ(r.status, TossStatus::Settled);
   EXPECT_EQ(capped.support_search_capped, 1u);
   EXPECT_EQ(plain.support_search_capped, 0u);
+  EXPECT_EQ(r.corrections.support_search_capped, 1u);  // reported with the corrections (issue 39)
 }
 
 TEST(CylinderStepped, CoinOnItsSideOnePointLiftingSolvesExactly) {

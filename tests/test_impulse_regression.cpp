@@ -134,9 +134,11 @@ TEST(ImpulseStepper, ExactFallbacksAreCounted) {
   // A located step whose search runs out of trials (a nearly tangential touch: the longest trial
   // above the floor is taken, the corner touches in the next step) is counted too: toss 98.
   TossProbe capped;
-  toss(m, 1, 98, &capped);
+  const TossResult c = toss(m, 1, 98, &capped);
   EXPECT_EQ(capped.located_capped, 1u);
   EXPECT_EQ(quiet.located_capped, 0u);
+  // ... and reported with the toss's corrections (issue 39), where users look.
+  EXPECT_EQ(c.corrections.located_capped, 1u);
 }
 
 // A die at rest balanced exactly on an edge (its COM straight above the edge's midpoint) cannot
@@ -163,6 +165,7 @@ TEST(ImpulseStepper, ExactBalancesAreNudgedAndCounted) {
   EXPECT_EQ(r.status, TossStatus::Settled);
   EXPECT_GE(probe.nudges, 1u);
   EXPECT_LE(probe.nudges, 4u);  // at most four per stepper run
+  EXPECT_EQ(r.corrections.nudges, probe.nudges);  // reported with the corrections (issue 39)
   TossProbe thrown;  // a thrown die needs none
   toss(m, 1, 0, &thrown);
   EXPECT_EQ(thrown.nudges, 0u);
@@ -190,8 +193,10 @@ TEST(ImpulseStepper, HeldCornersStayOnTheFloor) {
   const DieModel m = compile(dicesim::testing::with_fidelity(
       load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/paper/die1.toml"), Fidelity::Impulse));
   TossProbe probe;
-  for (int i = 0; i < 1000; ++i) toss(m, 5, static_cast<std::uint64_t>(i), &probe);
+  std::uint64_t reported = 0;
+  for (int i = 0; i < 1000; ++i) reported += toss(m, 5, static_cast<std::uint64_t>(i), &probe).corrections.rise_dropped;
   EXPECT_LT(probe.max_held_sink, 10.0 * held_corner_sink(m)) << probe.max_held_sink;
   EXPECT_GT(probe.short_steps, 0u);  // the bound shortened some steps
   EXPECT_LT(probe.rise_dropped, 10u);
+  EXPECT_EQ(reported, probe.rise_dropped);  // each one reported with the toss's corrections (issue 39)
 }
