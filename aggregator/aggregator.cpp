@@ -150,13 +150,18 @@ bool Aggregator::valid_batch(const dicesim_lcm::toss_batch& b) const {
   const std::size_t n = static_cast<std::size_t>(b.count);
   if (b.count < 1 || b.outcomes.size() != n || b.statuses.size() != n || b.bounces.size() != n) return false;
   const std::size_t nc = static_cast<std::size_t>(b.n_corrected);
-  if (b.n_corrected < 0 || b.corrected_offset.size() != nc || b.energy_clamps.size() != nc ||
-      b.pgs_unconverged.size() != nc || b.overlap_fixes.size() != nc || b.fallbacks.size() != nc)
-    return false;
-  for (std::size_t j = 0; j < nc; ++j)
-    if (b.corrected_offset[j] < 0 || b.corrected_offset[j] >= b.count || b.energy_clamps[j] < 0 || b.pgs_unconverged[j] < 0 ||
-        b.overlap_fixes[j] < 0 || b.fallbacks[j] < 0)
-      return false;
+  const std::vector<std::int32_t>* kinds[] = {&b.energy_clamps, &b.pgs_unconverged, &b.overlap_fixes, &b.fallbacks,
+                                              &b.located_capped, &b.support_search_capped, &b.rise_dropped, &b.depth_held,
+                                              &b.nudges};
+  static_assert(std::size(kinds) == RunCorrections::kKinds);
+  if (b.n_corrected < 0 || b.corrected_offset.size() != nc) return false;
+  for (const auto* k : kinds)
+    if (k->size() != nc) return false;
+  for (std::size_t j = 0; j < nc; ++j) {
+    if (b.corrected_offset[j] < 0 || b.corrected_offset[j] >= b.count) return false;
+    for (const auto* k : kinds)
+      if ((*k)[j] < 0) return false;
+  }
   for (std::size_t k = 0; k < n; ++k) {
     const int outcome = b.outcomes[k], status = b.statuses[k];
     if (b.bounces[k] < 0) return false;
@@ -228,6 +233,11 @@ void Aggregator::ingest(std::uint64_t first, std::uint64_t lo, std::uint64_t hi,
       c.corrections.pgs_unconverged += static_cast<std::uint64_t>(b.pgs_unconverged[j]);
       c.corrections.overlap_fixes += static_cast<std::uint64_t>(b.overlap_fixes[j]);
       c.corrections.fallbacks += static_cast<std::uint64_t>(b.fallbacks[j]);
+      c.corrections.located_capped += static_cast<std::uint64_t>(b.located_capped[j]);
+      c.corrections.support_search_capped += static_cast<std::uint64_t>(b.support_search_capped[j]);
+      c.corrections.rise_dropped += static_cast<std::uint64_t>(b.rise_dropped[j]);
+      c.corrections.depth_held += static_cast<std::uint64_t>(b.depth_held[j]);
+      c.corrections.nudges += static_cast<std::uint64_t>(b.nudges[j]);
     }
     blocks_.try_emplace(block, static_cast<int>(outcomes_)).first->second.merge(c);
     all_.merge(c);
@@ -485,10 +495,9 @@ dicesim_lcm::probabilities Aggregator::snapshot() const {
   m.rejected_malformed = static_cast<std::int64_t>(health_.malformed);
   m.rejected_range = static_cast<std::int64_t>(health_.range);
   m.released = static_cast<std::int64_t>(health_.released);
-  m.corrections[0] = static_cast<std::int64_t>(c.corrections.energy_clamps);
-  m.corrections[1] = static_cast<std::int64_t>(c.corrections.pgs_unconverged);
-  m.corrections[2] = static_cast<std::int64_t>(c.corrections.overlap_fixes);
-  m.corrections[3] = static_cast<std::int64_t>(c.corrections.fallbacks);
+  static_assert(std::size(decltype(m.corrections){}) == RunCorrections::kKinds);
+  int kind = 0;
+  c.corrections.for_each([&](const char*, std::uint64_t n) { m.corrections[kind++] = static_cast<std::int64_t>(n); });
   m.rejected_unauthenticated = static_cast<std::int64_t>(health_.unauthenticated);
   return m;
 }

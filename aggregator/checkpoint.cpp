@@ -40,7 +40,7 @@ std::vector<std::uint8_t> from_hex(const std::string& s) {
 // of 6) must be added here and in counts_from, or a resumed run would lose it. The assertion
 // makes such a change stop here until it is.
 static_assert(sizeof(RunCounts) == sizeof(std::vector<std::uint64_t>) + 4 * sizeof(std::uint64_t) + sizeof(RunCorrections) &&
-                  sizeof(RunCorrections) == 4 * sizeof(std::uint64_t),
+                  sizeof(RunCorrections) == RunCorrections::kKinds * sizeof(std::uint64_t),
               "RunCounts changed: serialise the new fields in counts_json / counts_from");
 json counts_json(const RunCounts& c) {
   const RunCorrections& k = c.corrections;
@@ -49,7 +49,11 @@ json counts_json(const RunCounts& c) {
           {"unresolved", c.unresolved},
           {"invalid", c.invalid},
           {"bounces", c.bounces},
-          {"corrections", {k.energy_clamps, k.pgs_unconverged, k.overlap_fixes, k.fallbacks}}};
+          {"corrections", [&] {
+             json a = json::array();  // corrections.hpp's for_each order
+             k.for_each([&](const char*, std::uint64_t n) { a.push_back(n); });
+             return a;
+           }()}};
 }
 
 RunCounts counts_from(const json& j) {
@@ -59,8 +63,14 @@ RunCounts counts_from(const json& j) {
   c.unresolved = j.at("unresolved").get<std::uint64_t>();
   c.invalid = j.at("invalid").get<std::uint64_t>();
   c.bounces = j.at("bounces").get<std::uint64_t>();
-  const auto k = j.at("corrections").get<std::array<std::uint64_t, 4>>();
-  c.corrections = {k[0], k[1], k[2], k[3]};
+  // The kinds in for_each order; a checkpoint written before the sustained phase's guards were
+  // counted holds the first four (the rest start at 0).
+  const auto k = j.at("corrections").get<std::vector<std::uint64_t>>();
+  if (k.size() != 4 && k.size() != RunCorrections::kKinds)
+    throw std::runtime_error("checkpoint: corrections has " + std::to_string(k.size()) + " counts, expected 4 or " +
+                             std::to_string(RunCorrections::kKinds));
+  std::size_t i = 0;
+  c.corrections.for_each([&](const char*, std::uint64_t& n) { n = i < k.size() ? k[i] : 0; ++i; });
   return c;
 }
 

@@ -58,21 +58,26 @@ double rate(const RunReport& r) { return r.elapsed_s > 0.0 ? static_cast<double>
 }  // namespace
 
 nlohmann::json corrections_json(const RunCorrections& k) {
-  return {{"energy_clamps", k.energy_clamps},
-          {"pgs_unconverged", k.pgs_unconverged},
-          {"overlap_fixes", k.overlap_fixes},
-          {"fallbacks", k.fallbacks}};
+  nlohmann::json j = nlohmann::json::object();
+  k.for_each([&](const char* name, std::uint64_t n) { j[name] = n; });
+  return j;
 }
 
 std::string corrections_line(const RunCorrections& k) {
   if (!k.any()) return {};
+  // The four repairs of the law always, then the sustained phase's guards that fired.
   char line[320];
   std::snprintf(line, sizeof line,
-                "corrections: %llu energy clamps, %llu unconverged contact solves, %llu overlap fixes, %llu fallbacks "
-                "(each should be 0: the physics was repaired)\n",
+                "corrections: %llu energy clamps, %llu unconverged contact solves, %llu overlap fixes, %llu fallbacks",
                 static_cast<unsigned long long>(k.energy_clamps), static_cast<unsigned long long>(k.pgs_unconverged),
                 static_cast<unsigned long long>(k.overlap_fixes), static_cast<unsigned long long>(k.fallbacks));
-  return line;
+  std::string out = line;
+  int i = 0;
+  k.for_each([&](const char* name, std::uint64_t n) {
+    if (i++ < 4 || n == 0) return;
+    out += ", " + std::to_string(n) + " " + name;
+  });
+  return out + " (each should be 0: the physics was repaired or a guard fired; docs/fidelity.md)\n";
 }
 
 nlohmann::json json_number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }

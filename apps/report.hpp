@@ -42,8 +42,9 @@ struct RunReport {
 // {"scene", "fidelity", "seed", "threads", "tosses", "settled", "unresolved", "invalid",
 //  "faces": [{"face", "count", "p", "ci95": [lo, hi]} (a coin's also "name": heads, tails, edge)], "chi2_uniform": {"statistic", "dof", "p_value"},
 //  "chi2_heads_tails": a coin's heads against tails, edge landings left out (1 dof; null for a die),
-//  "corrections": {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks"} (totals over
-//  the run; the table prints a line only when one is non-zero), "elapsed_s", "tosses_per_s"} -- p and
+//  "corrections": {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks", "located_capped",
+//  "support_search_capped", "rise_dropped", "depth_held", "nudges"} (totals over the run; the table
+//  prints a line only when one is non-zero), "elapsed_s", "tosses_per_s"} -- p and
 //  intervals over settled tosses; "partial": true when interrupted (then "tosses" is the complete
 //  prefix run, "tosses_requested" what was asked), "tosses_requested", "provenance" (provenance.hpp); faces by label (N outcomes; chi-square on N - 1 dof against every
 //  face equally likely, grouped labels weighted by their faces).
@@ -52,9 +53,10 @@ nlohmann::json report_json(const RunReport& r);
 nlohmann::json json_number(double v);
 // {"statistic", "dof", "p_value"}: every command's chi-square test, written one way.
 nlohmann::json chi2_json(const ChiSquare& c);
-// {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks"}: the run's totals (toss, run, sweep points).
+// Every kind of RunCorrections by name (corrections.hpp for_each): the run's totals (toss, run, sweep points).
 nlohmann::json corrections_json(const RunCorrections& k);
-// "corrections: N energy clamps, ... (each should be 0: the physics was repaired)", or "" when all are 0.
+// "corrections: N energy clamps, ... M nudges (each should be 0: ...)", or "" when all are 0 (the
+// four repairs of the law always, the sustained phase's guards when non-zero).
 std::string corrections_line(const RunCorrections& k);
 // Fills labels and faces_per_label from the model, and fidelity_requested and fidelity_reason.
 void set_labels(RunReport& r, const DieModel& m);

@@ -78,9 +78,10 @@ bool plausible_run_start(const void* data, std::size_t len) {
 bool plausible_probabilities(const void* data, std::size_t len) {
   Walker w(data, len);
   std::int32_t n = 0;
-  // hash utime run_id; n labels (4) + counts p ci_lo ci_hi (8 each); then 133 bytes of scalars
+  // hash utime run_id; n labels (4) + counts p ci_lo ci_hi (8 each); then 173 bytes of scalars
+  // (nine corrections of 8 bytes among them)
   return w.skip(8 + 8 + 8) && w.count(n, 36) && n >= 1 && n <= kMaxOutcomes && w.skip(static_cast<std::size_t>(n) * 36) &&
-         w.skip(133) && w.at_end();
+         w.skip(173) && w.at_end();
 }
 
 bool valid_outcome_labels(const std::vector<std::int32_t>& labels) {
@@ -99,6 +100,9 @@ const char* legacy_format(const void* data, std::size_t len) {
     case 0x16854fcd47c16d6eULL: return "run_start of the six-outcome wire (no outcome labels)";
     case 0x5196dd2e391cfd23ULL: return "toss_batch of the six-outcome wire (faces 1..6)";
     case 0xefc6a3d437de62eaULL: return "probabilities of the six-outcome wire ([6] arrays)";
+    // ... and of the wire whose corrections had four kinds (before the sustained phase's guards).
+    case 0xa777923107885cfeULL: return "toss_batch of the four-corrections wire";
+    case 0x763722945abe8778ULL: return "probabilities of the four-corrections wire (corrections[4])";
     default: return nullptr;
   }
 }
@@ -106,9 +110,9 @@ const char* legacy_format(const void* data, std::size_t len) {
 bool plausible_toss_batch(const void* data, std::size_t len) {
   Walker w(data, len);
   std::int32_t n = 0;
-  std::int32_t corrected = 0;  // tosses with corrections: offset and four counts, 20 bytes each
+  std::int32_t corrected = 0;  // tosses with corrections: offset and nine counts, 40 bytes each
   return w.skip(8 + 5 * 8) && w.count(n, 6) && n <= kMaxBatch && w.skip(static_cast<std::size_t>(n) * 6) &&
-         w.count(corrected, 20) && corrected <= n && w.skip(static_cast<std::size_t>(corrected) * 20) && w.at_end();
+         w.count(corrected, 40) && corrected <= n && w.skip(static_cast<std::size_t>(corrected) * 40) && w.at_end();
 }
 
 bool plausible_worker_status(const void* data, std::size_t len) {

@@ -47,8 +47,9 @@ static_assert(kMaxOutcomes < 128, "toss_batch.outcomes is int8");
 bool valid_outcome_labels(const std::vector<std::int32_t>& labels);
 
 // Messages recorded before a die could have any number of outcomes (toss_batch faces 1..6,
-// fixed [6] arrays in probabilities, run_start without outcome labels) have other LCM type
-// hashes and never decode as today's types. Names the old type if `data` is one, else nullptr.
+// fixed [6] arrays in probabilities, run_start without outcome labels), or before the corrections
+// had nine kinds (toss_batch and probabilities with four), have other LCM type hashes and never
+// decode as today's types. Names the old type if `data` is one, else nullptr.
 const char* legacy_format(const void* data, std::size_t len);
 
 // Counted arrays in lcm-gen's decoders are resized before their bytes are checked, so a hostile

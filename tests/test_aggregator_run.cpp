@@ -84,10 +84,11 @@ struct Fixture {
   wire::RunSpec spec;
   DieModel model;
   agg::AggregatorConfig cfg;
-  explicit Fixture(std::uint64_t total, std::uint64_t seed = 3, double target = 0.0) {
+  explicit Fixture(std::uint64_t total, std::uint64_t seed = 3, double target = 0.0, std::string fidelity = {}) {
     spec.run_id = 1234;
     spec.origin = DICESIM_SOURCE_DIR "/scenes/paper/die1.toml";
     spec.files = wire::read_scene_files(spec.origin);
+    if (!fidelity.empty()) spec.overrides = {"sim.fidelity=" + fidelity};
     spec.seed = seed;
     spec.total = total;
     model = wire::compile_spec(spec);
@@ -122,6 +123,19 @@ TEST(AggregatorRun, ThreeWorkersGiveTheCountsOfOneThread) {
   EXPECT_EQ(net.agg->health().duplicates, 0u);
   EXPECT_EQ(net.agg->health().malformed, 0u);
   for (auto& w : net.workers) EXPECT_GT(w->tosses_done(), 0u) << "every worker takes part";
+}
+
+// The sustained phase's guards (issue 39) travel in toss_batch like the other corrections: an
+// `impulse` Die 1 run has located steps out of trials (located_capped), and the aggregator's
+// totals of every kind are one thread's.
+TEST(AggregatorRun, SustainedPhaseGuardsArriveAsCounted) {
+  Fixture f(1500, 3, 0.0, "impulse");
+  const RunCounts ref = f.reference(1500);
+  ASSERT_GT(ref.corrections.located_capped, 0u) << "the run must exercise a guard of the sustained phase";
+  Net net = make_net(f, 2);
+  ASSERT_TRUE(net.run());
+  EXPECT_EQ(net.agg->result().corrections, ref.corrections);
+  EXPECT_EQ(net.agg->result(), ref);
 }
 
 TEST(AggregatorRun, LossyBusStillGivesIdenticalCounts) {

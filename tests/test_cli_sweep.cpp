@@ -78,7 +78,8 @@ TEST(CliSweep, EveryPointReportsItsCorrectionsAsTossDoes) {
   ASSERT_EQ(t.code, 0) << t.err;
   const auto k = nlohmann::json::parse(t.out)["corrections"];
   bool any = false;
-  for (const char* key : {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks"}) {
+  for (const char* key : {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks", "located_capped",
+                          "support_search_capped", "rise_dropped", "depth_held", "nudges"}) {
     ASSERT_TRUE(p["corrections"].contains(key)) << key;
     EXPECT_EQ(p["corrections"][key], k[key]) << key;
     any = any || k[key].get<long long>() > 0;

@@ -75,7 +75,9 @@ void expect_solved_by(const char* scene, std::uint64_t index, std::uint64_t Toss
   const TossResult r = toss(m, 1, index, &probe);
   EXPECT_EQ(r.status, TossStatus::Settled) << scene << " " << index;
   EXPECT_EQ(r.corrections.pgs_unconverged, 0u) << scene << " " << index;
-  EXPECT_FALSE(r.corrections.any()) << scene << " " << index;
+  // No repair of the law (the sustained phase's guards, issue 39, may fire: a located step out of
+  // trials is not a repair).
+  EXPECT_EQ(r.corrections.energy_clamps + r.corrections.overlap_fixes + r.corrections.fallbacks, 0u) << scene << " " << index;
   EXPECT_GE(probe.*used, 1u) << scene << " " << index;
 }
 
@@ -830,6 +832,7 @@ TEST(CylinderImpulse, SupportSearchesOutOfIterationsAreCounted) {
   EXPECT_EQ(r.status, TossStatus::Settled);
   EXPECT_EQ(capped.support_search_capped, 1u);
   EXPECT_EQ(plain.support_search_capped, 0u);
+  EXPECT_EQ(r.corrections.support_search_capped, 1u);  // reported with the corrections (issue 39)
 }
 
 TEST(CylinderStepped, CoinOnItsSideOnePointLiftingSolvesExactly) {
@@ -891,7 +894,11 @@ TEST(CylinderStepped, FlatCoinsSpinOverStrikesTheRimBetweenTheTripod) {
     TossProbe probe;
     const TossResult r = toss(m, 1, i, &probe);
     EXPECT_EQ(r.status, TossStatus::Settled) << i;
-    EXPECT_FALSE(r.corrections.any()) << i;
+    // No repair of the law (the sustained phase's guards, issue 39, may fire).
+    EXPECT_EQ(r.corrections.energy_clamps + r.corrections.pgs_unconverged + r.corrections.overlap_fixes +
+                  r.corrections.fallbacks,
+              0u)
+        << i;
     EXPECT_LE(probe.max_energy_gain, 1e-12) << i;
     EXPECT_GE(probe.rim_struck, 1u) << i;  // by the rim strike, and counted
   }

@@ -134,9 +134,11 @@ TEST(ImpulseStepper, ExactFallbacksAreCounted) {
   // A located step whose search runs out of trials (a nearly tangential touch: the longest trial
   // above the floor is taken, the corner touches in the next step) is counted too: toss 98.
   TossProbe capped;
-  toss(m, 1, 98, &capped);
+  const TossResult c = toss(m, 1, 98, &capped);
   EXPECT_EQ(capped.located_capped, 1u);
   EXPECT_EQ(quiet.located_capped, 0u);
+  // ... and reported with the toss's corrections (issue 39), where users look.
+  EXPECT_EQ(c.corrections.located_capped, 1u);
 }
 
 // A die at rest balanced exactly on an edge (its COM straight above the edge's midpoint) cannot
@@ -163,6 +165,7 @@ TEST(ImpulseStepper, ExactBalancesAreNudgedAndCounted) {
   EXPECT_EQ(r.status, TossStatus::Settled);
   EXPECT_GE(probe.nudges, 1u);
   EXPECT_LE(probe.nudges, 4u);  // at most four per stepper run
+  EXPECT_EQ(r.corrections.nudges, probe.nudges);  // reported with the corrections (issue 39)
   TossProbe thrown;  // a thrown die needs none
   toss(m, 1, 0, &thrown);
   EXPECT_EQ(thrown.nudges, 0u);

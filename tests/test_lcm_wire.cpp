@@ -50,12 +50,24 @@ TEST(LcmWire, TossBatchCarriesCorrections) {
   b.pgs_unconverged = {2, 1};
   b.overlap_fixes = {0, 0};
   b.fallbacks = {1, 0};
+  // The sustained phase's guards (issue 39) travel the same way.
+  b.located_capped = {0, 3};
+  b.support_search_capped = {4, 0};
+  b.rise_dropped = {0, 5};
+  b.depth_held = {6, 0};
+  b.nudges = {0, 2};
   const auto bytes = w::encode(b);
+  EXPECT_TRUE(w::plausible_toss_batch(bytes.data(), bytes.size()));
   const auto d = w::decode<dicesim_lcm::toss_batch>(bytes.data(), bytes.size());
   ASSERT_TRUE(d.has_value());
   EXPECT_EQ(d->corrected_offset, b.corrected_offset);
   EXPECT_EQ(d->pgs_unconverged, b.pgs_unconverged);
   EXPECT_EQ(d->fallbacks, b.fallbacks);
+  EXPECT_EQ(d->located_capped, b.located_capped);
+  EXPECT_EQ(d->support_search_capped, b.support_search_capped);
+  EXPECT_EQ(d->rise_dropped, b.rise_dropped);
+  EXPECT_EQ(d->depth_held, b.depth_held);
+  EXPECT_EQ(d->nudges, b.nudges);
 }
 
 TEST(LcmWire, EveryTruncationOfEveryTypeIsRejected) {
@@ -250,6 +262,13 @@ TEST(LcmWire, SixOutcomeWireMessagesAreRecognisedAsTheOldFormat) {
   const auto now = w::encode(sample_batch(3));
   EXPECT_EQ(w::legacy_format(now.data(), now.size()), nullptr);
   EXPECT_FALSE(w::decode<dicesim_lcm::toss_batch>(old_batch, sizeof old_batch).has_value());
+  // The wire whose corrections had four kinds (before issue 39): its toss_batch and probabilities.
+  const std::uint8_t four_batch[] = {0xa7, 0x77, 0x92, 0x31, 0x07, 0x88, 0x5c, 0xfe, 0, 0};
+  const std::uint8_t four_prob[] = {0x76, 0x37, 0x22, 0x94, 0x5a, 0xbe, 0x87, 0x78, 0, 0};
+  ASSERT_NE(w::legacy_format(four_batch, sizeof four_batch), nullptr);
+  EXPECT_NE(std::string(w::legacy_format(four_batch, sizeof four_batch)).find("four-corrections"), std::string::npos);
+  ASSERT_NE(w::legacy_format(four_prob, sizeof four_prob), nullptr);
+  EXPECT_NE(std::string(w::legacy_format(four_prob, sizeof four_prob)).find("corrections[4]"), std::string::npos);
 }
 
 TEST(LcmWire, RunStartWithEscapingPathsIsRefused) {

@@ -234,6 +234,33 @@ TEST(Checkpoint, JsonRoundTripKeepsEveryField) {
   }
 }
 
+// Every kind of correction survives a checkpoint (issue 39: the sustained phase's guards too), and
+// a checkpoint written when the counts held four kinds still reads (the rest 0).
+TEST(Checkpoint, EveryCorrectionKindRoundTrips) {
+  TestRun r(5000);
+  Bus bus;
+  bus.agg = std::make_unique<agg::Aggregator>(r.cfg, bus.sender());
+  bus.add_worker({});
+  for (int i = 0; i < 12; ++i) bus.step();
+  agg::Checkpoint c = bus.agg->checkpoint(1.5);
+  std::uint64_t v = 1;
+  c.all.corrections.for_each([&](const char*, std::uint64_t& n) { n = v++; });
+  c.prefix.corrections = c.all.corrections;
+  const agg::Checkpoint d = agg::checkpoint_from_json(agg::to_json(c), "mem");
+  EXPECT_EQ(d.all.corrections, c.all.corrections);
+  EXPECT_EQ(d.all.corrections.nudges, 9u);
+  EXPECT_EQ(d.prefix.corrections.located_capped, 5u);
+  nlohmann::json j = nlohmann::json::parse(agg::to_json(c));
+  ASSERT_EQ(j["all"]["corrections"].size(), 9u);
+  for (const char* part : {"all", "prefix"}) j[part]["corrections"] = {1, 2, 3, 4};
+  const agg::Checkpoint old = agg::checkpoint_from_json(j.dump(), "old.ckpt");
+  EXPECT_EQ(old.all.corrections.fallbacks, 4u);
+  EXPECT_EQ(old.all.corrections.located_capped, 0u);
+  EXPECT_EQ(old.all.corrections.nudges, 0u);
+  j["all"]["corrections"] = {1, 2, 3};
+  EXPECT_THROW(agg::checkpoint_from_json(j.dump(), "three.ckpt"), agg::CheckpointError);
+}
+
 TEST(Checkpoint, ResumedAggregatorGivesTheCountsOfOneThread) {
   TestRun r(6000);
   r.cfg.key = key_of(4);  // a resumed authenticated run: the key is given again, never stored

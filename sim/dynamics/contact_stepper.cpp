@@ -1272,7 +1272,7 @@ int FixedStepper::step(RigidState& s, double ke) {
       if (have_lo) {
         done = lo;
         dt = d_lo;
-      } else {  // every trial ended below: the shortest, its corner within rounding of the floor
+      } else {  // every trial ended below: the shortest, its corner lifted to the floor at the end (flat dice)
         try_step(s0, c, d_hi, *trial);
         ++located_trials;
         done = trial;
@@ -1458,7 +1458,21 @@ int FixedStepper::step(RigidState& s, double ke) {
   } else {
     max_energy_gain = std::max(max_energy_gain, relative_gain(E0, end_ke_ + m.mass * m.gravity * s.position.z()));
   }
+  {
+    // Plain E over the step (the lifts below are counted corrections, not the step's).
+    const double mg = m.mass * m.gravity;
+    const double plain = end_ke_ + mg * s.position.z();
+    max_step_rise = std::max(max_step_rise, (plain - E0) / mg);
+    max_rise_excess = std::max(max_rise_excess, relative_gain(E0 + mg * start_depth_max_, plain));
+  }
   if (a.rise_dropped) ++rise_dropped;
+  if (!m.curved() && a.G < -touch_tol_) {
+    // Only a located step whose every trial ended below the floor (locate: the shortest taken)
+    // ends with a corner not in c deeper than the touch tolerance: the COM is lifted by its depth,
+    // the corner put on the floor, counted (overlap_fixes; the step is also located_capped).
+    s.position.z() -= a.G;
+    ++corrections.overlap_fixes;
+  }
   if (m.curved()) {
     // The rims end every step within the touch tolerance of the floor or above it; where the step
     // left them deeper (a slapping rim, whose plain solve does not push, rim_support; a bias not
@@ -1499,6 +1513,8 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->located_capped += st.located_capped;
       stats->nudges += static_cast<std::uint64_t>(out.nudges);
       stats->max_energy_gain = std::max(stats->max_energy_gain, st.max_energy_gain);
+      stats->max_step_rise = std::max(stats->max_step_rise, st.max_step_rise);
+      stats->max_rise_excess = std::max(stats->max_rise_excess, st.max_rise_excess);
       stats->max_penetration = std::max(stats->max_penetration, st.max_penetration);
       stats->halved += st.halved;
       stats->curvature_capped += st.curvature_capped;
@@ -1519,6 +1535,13 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->sink_shortened += st.sink_shortened;
       stats->short_steps += st.short_steps;
       stats->rise_dropped += st.rise_dropped;
+      // The guards of the sustained phase, reported with the corrections (kept out of the
+      // stepper's own, whose totals decide its re-tried steps).
+      stats->corrections.located_capped += static_cast<std::uint32_t>(st.located_capped);
+      stats->corrections.support_search_capped += static_cast<std::uint32_t>(st.support_search_capped);
+      stats->corrections.rise_dropped += static_cast<std::uint32_t>(st.rise_dropped);
+      stats->corrections.depth_held += static_cast<std::uint32_t>(st.depth_held);
+      stats->corrections.nudges += static_cast<std::uint32_t>(out.nudges);
     }
     return out;
   };

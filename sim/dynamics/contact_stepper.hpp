@@ -94,6 +94,11 @@ class FixedStepper {
   // the longest trial that ends above the floor taken, the corner touching in the next step.
   std::uint64_t located_capped = 0;
   double max_energy_gain = 0.0;   // largest relative gain of one impact's kinetic or one step's mechanical energy
+  // Plain E = kinetic + m g z_COM over one accepted step (before any counted lift), docs/fidelity.md
+  // "Energy": its largest rise as a height, (E_end - E_start) / (m g) (m), and the largest relative
+  // excess of E_end over E_start + m g (the deepest held corner's depth at the step's start).
+  double max_step_rise = 0.0;
+  double max_rise_excess = 0.0;
   double max_penetration = 0.0;   // curved dice: deepest lowest point below the floor at a step's end (m)
   std::uint64_t curvature_impulses = 0;  // curved dice: mid-step curvature impulses (rim_support)
   std::uint64_t curvature_capped = 0;    // ... of them capped to gain no energy
@@ -340,6 +345,8 @@ struct StepperStats {
   std::uint64_t located_capped = 0;  // ... not within the tolerance in kMaxTrials trials (FixedStepper)
   std::uint64_t nudges = 0;          // exact balances at rest broken by the toss's tiebreak (a tiny spin)
   double max_energy_gain = 0.0;
+  double max_step_rise = 0.0;    // FixedStepper::max_step_rise (m)
+  double max_rise_excess = 0.0;  // FixedStepper::max_rise_excess (relative)
   double max_penetration = 0.0;  // curved dice: deepest lowest point below the floor at a step's end (m)
   // Curved dice, adaptive steps (not corrections): steps halved because a capped curvature impulse
   // left the rims sinking, curvature impulses capped (in any trial), steps shortened to a slap.

@@ -22,6 +22,8 @@ inline void add_stepper_stats(TossProbe& probe, const StepperStats& stats) {
   probe.located_capped += stats.located_capped;
   probe.nudges += stats.nudges;
   probe.max_energy_gain = std::max(probe.max_energy_gain, stats.max_energy_gain);
+  probe.max_step_rise = std::max(probe.max_step_rise, stats.max_step_rise);
+  probe.max_rise_excess = std::max(probe.max_rise_excess, stats.max_rise_excess);
   probe.max_penetration = std::max(probe.max_penetration, stats.max_penetration);
   probe.halved += stats.halved;
   probe.max_held_sink = std::max(probe.max_held_sink, stats.max_held_sink);

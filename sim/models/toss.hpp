@@ -72,6 +72,8 @@ struct TossProbe {
   std::uint64_t located_capped = 0;  // ... not within the touch tolerance in the trials allowed (the longest above taken)
   std::uint64_t nudges = 0;          // exact balances at rest broken by the toss's tiebreak (a spin of 1e-4 sqrt(g/r))
   double max_energy_gain = 0.0;
+  double max_step_rise = 0.0;    // plain kinetic + m g z over one fixed step: its largest rise / (m g) (m)
+  double max_rise_excess = 0.0;  // ... its largest relative excess over m g (the deepest held corner's start depth)
   double max_penetration = 0.0;  // curved dice: deepest rim below the floor at any fixed step's end (m)
   std::uint64_t halved = 0;            // curved dice: fixed steps halved (a capped curvature impulse)
   std::uint64_t curvature_capped = 0;  // curved dice: curvature impulses capped to gain no energy (any trial)

@@ -266,6 +266,11 @@ bool WorkerCore::step(double now) {
       b.pgs_unconverged.push_back(static_cast<std::int32_t>(r.corrections.pgs_unconverged));
       b.overlap_fixes.push_back(static_cast<std::int32_t>(r.corrections.overlap_fixes));
       b.fallbacks.push_back(static_cast<std::int32_t>(r.corrections.fallbacks));
+      b.located_capped.push_back(static_cast<std::int32_t>(r.corrections.located_capped));
+      b.support_search_capped.push_back(static_cast<std::int32_t>(r.corrections.support_search_capped));
+      b.rise_dropped.push_back(static_cast<std::int32_t>(r.corrections.rise_dropped));
+      b.depth_held.push_back(static_cast<std::int32_t>(r.corrections.depth_held));
+      b.nudges.push_back(static_cast<std::int32_t>(r.corrections.nudges));
     }
     for (const BounceRecord& rec : records) {
       if (trace_tokens_ < 1.0) {
