@@ -25,6 +25,8 @@ struct SceneArgs {
   std::string fidelity;
   void add_to(CLI::App* cmd);
   SceneDef load() const;  // throws SceneError
+  // The overrides load() applies, in order: every --set, then --fidelity as sim.fidelity="F" (provenance).
+  std::vector<std::string> applied_overrides() const;
 };
 
 // --key-file FILE (authenticated runs, messages/auth.hpp), with the same help on every command.
@@ -49,6 +51,7 @@ void register_bridge(CLI::App& app, int& exit_code);  // cmd_bridge.cpp
 void register_watch(CLI::App& app, int& exit_code);   // cmd_watch.cpp
 void register_record(CLI::App& app, int& exit_code);  // cmd_record.cpp
 void register_replay(CLI::App& app, int& exit_code);  // cmd_replay.cpp
+void register_version(CLI::App& app, int& exit_code); // cmd_version.cpp
 
 // Distributed runs (cmd_aggregate.cpp): what `aggregate` and `run` share.
 struct AggregateArgs {
