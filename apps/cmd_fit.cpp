@@ -59,6 +59,12 @@ void write_profile_plot(const std::string& path, const FitResult& r) {
     const std::string unit = key_unit(p.key);
     gp << "set xlabel " << gnuplot_quote(unit.empty() ? p.key : p.key + " (" + unit + ")") << " noenhanced\n";
     gp << "set yrange [0:8]\n";
+    if (!p.identifiable) {  // its profile is flat: no interval, no estimate
+      gp << "$p << EOD\n";
+      for (const auto& row : p.profile) gp << number_text(row[0]) << " " << number_text(row[1]) << "\n";
+      gp << "EOD\nplot $p using 1:2 with lines lw 2 title 'profile (not identifiable)'\n";
+      continue;
+    }
     gp << "set arrow from " << number_text(p.ci95.lo) << ",0 to " << number_text(p.ci95.lo) << ",3.841 nohead dt 2\n";
     gp << "set arrow from " << number_text(p.ci95.hi) << ",0 to " << number_text(p.ci95.hi) << ",3.841 nohead dt 2\n";
     gp << "$p << EOD\n";
@@ -83,22 +89,49 @@ void print_text(const FitResult& r, const FitArgs& a, const FitOptions& opt) {
     for (const auto c : d.observed) n += c;
     std::printf("  %s on %s: %llu observed tosses\n", d.source.c_str(), d.scene.c_str(), static_cast<unsigned long long>(n));
   }
+  if (!r.estimated) {  // no estimate: say which key the simulated probabilities do not feel
+    std::printf("\n");
+    for (const FitParamResult& p : r.params) {
+      if (p.identifiable)
+        std::printf("%s: moves the outcomes (up to %.3g standard errors); refit without the keys below\n", p.key.c_str(),
+                    p.shift_z);
+      else
+        std::printf("%s: not identifiable from these data: over %g..%g it moves no outcome's probability by more than "
+                    "the Monte Carlo noise (largest change %.3g standard errors; %.3g needed)\n",
+                    p.key.c_str(), p.lo, p.hi, p.shift_z, p.shift_z_level);
+    }
+    std::printf("no estimate (%llu tosses simulated in %.1f s)\n", static_cast<unsigned long long>(r.simulated_tosses),
+                r.elapsed_s);
+    return;
+  }
   std::printf("\n%-28s %12s   %-27s %12s %14s\n", "parameter", "estimate", "95% interval", "MC sd", "ideal 95% +-");
   for (const FitParamResult& p : r.params) {
     char iv[64];
     std::snprintf(iv, sizeof iv, "[%.6g, %.6g]", p.ci95.lo, p.ci95.hi);
+    if (!p.identifiable) {
+      std::printf("%-28s not identifiable from these data (moves no outcome beyond the Monte Carlo noise over %g..%g)\n",
+                  p.key.c_str(), p.lo, p.hi);
+      continue;
+    }
     std::printf("%-28s %12.6g   %-27s %12.3g %14.4g\n", p.key.c_str(), p.estimate, iv, p.mc_sd, p.fisher_halfwidth);
   }
   for (const FitParamResult& p : r.params) {
+    if (!p.identifiable) continue;
     if (p.mc_large)
       std::printf("note: %s's Monte Carlo sd is over half the data's: the interval may be too narrow (raise --tosses)\n",
                   p.key.c_str());
-    if (p.lo_open)
+    if (p.lo_open && p.box_lo <= p.lo)
       std::printf("note: %s's interval reaches the range's low end %g: the data do not bound it there (widen --param)\n",
                   p.key.c_str(), p.lo);
-    if (p.hi_open)
+    else if (p.lo_open)
+      std::printf("note: %s's interval reaches %g, the low end of the last (narrowed, then widened) box: open there; "
+                  "the data may not bound it (raise --rounds or --tosses)\n", p.key.c_str(), p.box_lo);
+    if (p.hi_open && p.box_hi >= p.hi)
       std::printf("note: %s's interval reaches the range's high end %g: the data do not bound it there (widen --param)\n",
                   p.key.c_str(), p.hi);
+    else if (p.hi_open)
+      std::printf("note: %s's interval reaches %g, the high end of the last (narrowed, then widened) box: open there; "
+                  "the data may not bound it (raise --rounds or --tosses)\n", p.key.c_str(), p.box_hi);
   }
   for (const FitDataResult& d : r.data) {
     std::uint64_t n = 0;
@@ -194,7 +227,8 @@ int run_fit_cmd(const FitArgs& a) {
     return kExitInterrupted;
   }
   bar.finish();
-  if (!a.plot.empty()) write_profile_plot(a.plot, r);
+  if (!a.plot.empty() && r.estimated) write_profile_plot(a.plot, r);
+  if (!a.plot.empty() && !r.estimated) std::fprintf(stderr, "dicesim fit: no profile to plot (%s not written)\n", a.plot.c_str());
   if (a.json)
     std::printf("%s\n", fit_json(r, opt).dump().c_str());
   else

@@ -10,6 +10,7 @@
 #include "apps/report.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/body/material_parts.hpp"
+#include "sim/body/outcome.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/models/fidelity_models.hpp"
 #include "sim/study/auto_pilot.hpp"
@@ -18,6 +19,30 @@ namespace dicesim {
 namespace {
 
 Vec3 geometric_normal(const DieModel& m, std::size_t f) { return m.geo_to_body.transpose() * m.face_normals[f]; }
+
+// Which outcome each resting face gives, and which outcomes the die's symmetry makes alike.
+void print_outcome_map(const DieModel& m) {
+  std::printf("\nresting on face -> outcome read%s\n", m.read_down ? " (the face on the floor)" : "");
+  std::string row;
+  for (int f = 0; f < m.face_count(); ++f) {
+    row += (row.empty() ? "  " : "   ") + std::to_string(f) + " -> " + std::to_string(resting_outcome_label(m, f));
+    if (row.size() > 90 || f + 1 == m.face_count()) {
+      std::printf("%s\n", row.c_str());
+      row.clear();
+    }
+  }
+  for (const int f : m.own_read_faces)
+    std::printf("  face %d reads its own label %d: resting on it, no single face is up (several tie)\n", f,
+                m.face_labels[static_cast<std::size_t>(f)]);
+  const auto groups = alike_groups(m);
+  std::string text;
+  for (const auto& g : groups) {
+    text += text.empty() ? "" : " | ";
+    for (std::size_t k = 0; k < g.size(); ++k) text += (k ? ", " : "") + std::to_string(g[k]);
+  }
+  std::printf("alike by design    %s\n  (%s)\n", groups.empty() ? "none: no outcome is tested against another" : text.c_str(),
+              m.alike_note.c_str());
+}
 
 // One format per kind of number, as in `toss`: SI quantities with 6 significant digits (%.6g),
 // unit directions with 4 decimals, probabilities with 5.
@@ -79,6 +104,7 @@ void print_info(const std::string& path, const DieModel& m, const FloorDef& floo
     else
       std::printf(" %s\n", m.face_hold[f] >= 0.0 ? "none (the only basin)" : "-");
   }
+  print_outcome_map(m);
   // Where the two numbers come from: the materials at the corner, or the scene's [floor] values.
   auto source = [](const char* what, bool from_floor) {
     return std::string(what) + (from_floor ? ": [floor] " + std::string(what) + " for every contact" : ": volume mix of the materials at the corner");

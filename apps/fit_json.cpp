@@ -33,12 +33,20 @@ nlohmann::json fit_json(const FitResult& r, const FitOptions& opt) {
                       {"ci95_profile", {json_number(p.ci95_profile.lo), json_number(p.ci95_profile.hi)}},
                       {"mc_sd", json_number(p.mc_sd)},
                       {"mc_large", p.mc_large},
-                      {"fisher_halfwidth", json_number(p.fisher_halfwidth)}});
+                      {"fisher_halfwidth", json_number(p.fisher_halfwidth)},
+                      {"box", {json_number(p.box_lo), json_number(p.box_hi)}},
+                      {"identifiable", p.identifiable},
+                      {"shift_z", json_number(p.shift_z)},
+                      {"shift_z_level", json_number(p.shift_z_level)}});
+  for (std::size_t i = 0; i < r.params.size(); ++i)
+    if (!r.params[i].identifiable)
+      params[i]["note"] = "not identifiable from these data: over its range it moves no outcome's probability by more "
+                          "than the Monte Carlo noise";
   // "fitted": one entry per outcome of every data set (with several, "data" tells them apart).
   nlohmann::json fitted = nlohmann::json::array(), data = nlohmann::json::array();
   for (std::size_t s = 0; s < r.data.size(); ++s) {
     const FitDataResult& d = r.data[s];
-    for (std::size_t k = 0; k < d.labels.size(); ++k) {
+    for (std::size_t k = 0; k < d.labels.size() && k < d.fitted.size(); ++k) {
       fitted.push_back({{"label", d.labels[k]}, {"p", json_number(d.fitted[k])}, {"observed", d.observed[k]}, {"data", s}});
       if (k < d.names.size()) fitted.back()["name"] = d.names[k];  // a coin's side
     }
@@ -46,9 +54,10 @@ nlohmann::json fit_json(const FitResult& r, const FitOptions& opt) {
   }
   nlohmann::json rounds = nlohmann::json::array();
   for (const FitRound& fr : r.rounds)
-    rounds.push_back({{"box_lo", fr.box_lo}, {"box_hi", fr.box_hi}, {"points", fr.points},
+    rounds.push_back({{"box_lo", fr.box_lo}, {"box_hi", fr.box_hi}, {"widened", fr.widened}, {"points", fr.points},
                       {"tosses_per_point", fr.tosses_per_point}, {"estimate", fr.estimate}});
   return {{"params", params},
+          {"estimated", r.estimated},
           {"fitted", fitted},
           {"gof", chi2_json(r.gof)},
           {"data", data},

@@ -2,6 +2,10 @@
 // label, normal, area, stable and p_static, mass properties, corners, fidelity, resting geometry.
 #include "apps/info_json.hpp"
 
+#include <algorithm>
+
+#include "sim/body/outcome.hpp"
+
 #include <cmath>
 #include <vector>
 
@@ -82,7 +86,10 @@ nlohmann::json info_json(const std::string& path, const DieModel& m, const std::
                            {"normal", vec(n)},
                            {"area", m.face_area[f]},
                            {"stable", m.face_hold[f] >= 0.0},
-                           {"p_static", p_static[f]}};
+                           {"p_static", p_static[f]},
+                           {"reads", resting_outcome_label(m, static_cast<int>(f))}};  // the outcome resting on it
+    if (std::find(m.own_read_faces.begin(), m.own_read_faces.end(), static_cast<int>(f)) != m.own_read_faces.end())
+      face["reads_own"] = true;  // no single face up when it rests on this one
     if (m.kind == "box") face["direction"] = kFaceDirNames[f];
     if (m.curved() && f < kCylinderOutcomeNames.size()) {
       face["direction"] = kCylinderOutcomeNames[f];  // heads (+z), tails (-z), edge: the curved side
@@ -115,6 +122,7 @@ nlohmann::json info_json(const std::string& path, const DieModel& m, const std::
           {"symmetric_top", m.symmetric_top},
           {"bounding_radius", m.bounding_radius},
           {"faces", faces},
+          {"alike", {{"groups", alike_groups(m)}, {"rotations", m.symmetry_rotations}, {"note", m.alike_note}}},
           {"corners", corners},
           {"fidelity", to_string(m.fidelity)},
           {"fidelity_requested", to_string(m.fidelity_requested)},

@@ -31,26 +31,52 @@ std::vector<FaceRow> face_rows(const RunReport& r) {
   return rows;
 }
 
-// Against every face equally likely: outcome k expected in proportion to its number of faces.
-ChiSquare chi2_fair(const RunReport& r) {
-  if (r.faces_per_label.size() != r.counts.faces.size()) return chi2_uniform(r.counts.faces);
-  double faces = 0.0;
-  for (int k : r.faces_per_label) faces += k;
-  std::vector<double> p;
-  for (int k : r.faces_per_label) p.push_back(k / faces);
-  return chi2_against(r.counts.faces, p);
+// The classes of outcomes alike by design with two or more outcomes, each tested against equal
+// probabilities within it (outcomes in label order).
+struct AlikeTest {
+  std::vector<int> labels;
+  std::vector<std::string> names;  // a coin's sides
+  ChiSquare chi;
+};
+
+std::vector<AlikeTest> alike_tests(const RunReport& r) {
+  std::vector<AlikeTest> tests;
+  if (r.alike.size() != r.counts.faces.size() || r.labels.size() != r.counts.faces.size()) return tests;
+  for (std::size_t first = 0; first < r.alike.size(); ++first) {
+    if (r.alike[first] != static_cast<int>(first)) continue;
+    AlikeTest t;
+    std::vector<std::uint64_t> counts;
+    for (std::size_t k = first; k < r.alike.size(); ++k)
+      if (r.alike[k] == static_cast<int>(first)) {
+        t.labels.push_back(r.labels[k]);
+        if (k < r.names.size()) t.names.push_back(r.names[k]);
+        counts.push_back(r.counts.faces[k]);
+      }
+    if (counts.size() < 2) continue;
+    t.chi = chi2_uniform(counts);
+    tests.push_back(std::move(t));
+  }
+  return tests;
 }
 
-// A fair coin: heads and tails equally likely. Its edge landings are a matter of thickness, not of
-// fairness, so they are left out (uniform over heads, tails and edge is no coin's expectation).
-// Needs heads and tails each alone in its outcome: a grouped side ("heads/edge") has no test.
-std::optional<ChiSquare> chi2_heads_tails(const RunReport& r) {
-  const auto heads = std::find(r.names.begin(), r.names.end(), "heads");
-  const auto tails = std::find(r.names.begin(), r.names.end(), "tails");
-  if (heads == r.names.end() || tails == r.names.end() || r.names.size() != r.counts.faces.size()) return std::nullopt;
-  const std::uint64_t two[2] = {r.counts.faces[static_cast<std::size_t>(heads - r.names.begin())],
-                                r.counts.faces[static_cast<std::size_t>(tails - r.names.begin())]};
-  return chi2_uniform(two);
+// Every outcome alike: the one test against a fair die.
+std::optional<ChiSquare> chi2_fair(const RunReport& r, const std::vector<AlikeTest>& tests) {
+  if (tests.size() == 1 && tests.front().labels.size() == r.counts.faces.size()) return tests.front().chi;
+  return std::nullopt;
+}
+
+// A fair coin: heads and tails alike, edge landings left out (a matter of thickness, not of
+// fairness). Needs heads and tails each alone in its outcome and the coin turned over onto itself.
+std::optional<ChiSquare> chi2_heads_tails(const std::vector<AlikeTest>& tests) {
+  for (const AlikeTest& t : tests)
+    if (t.names == std::vector<std::string>{"heads", "tails"}) return t.chi;
+  return std::nullopt;
+}
+
+std::string labels_text(const std::vector<int>& labels) {
+  std::string s;
+  for (const int l : labels) s += (s.empty() ? "" : ", ") + std::to_string(l);
+  return s;
 }
 
 double rate(const RunReport& r) { return r.elapsed_s > 0.0 ? static_cast<double>(r.tosses) / r.elapsed_s : 0.0; }
@@ -92,8 +118,15 @@ nlohmann::json report_json(const RunReport& r) {
     faces.push_back({{"face", f.label}, {"count", f.count}, {"p", f.p}, {"ci95", {f.ci.lo, f.ci.hi}}});
     if (!f.name.empty()) faces.back()["name"] = f.name;
   }
-  const ChiSquare chi = chi2_fair(r);
-  const auto coin = chi2_heads_tails(r);
+  const std::vector<AlikeTest> tests = alike_tests(r);
+  const auto fair = chi2_fair(r, tests);
+  const auto coin = chi2_heads_tails(tests);
+  nlohmann::json groups = nlohmann::json::array(), chi_alike = nlohmann::json::array();
+  for (const AlikeTest& t : tests) {
+    groups.push_back(t.labels);
+    chi_alike.push_back(chi2_json(t.chi));
+    chi_alike.back()["outcomes"] = t.labels;
+  }
   return {{"scene", r.scene},
           {"fidelity", r.fidelity},
           {"fidelity_requested", r.fidelity_requested},
@@ -108,7 +141,9 @@ nlohmann::json report_json(const RunReport& r) {
           {"unresolved", r.counts.unresolved},
           {"invalid", r.counts.invalid},
           {"faces", faces},
-          {"chi2_uniform", chi2_json(chi)},
+          {"alike", {{"groups", groups}, {"rotations", r.symmetry_rotations}, {"note", r.alike_note}}},
+          {"chi2_alike", chi_alike},
+          {"chi2_uniform", fair ? chi2_json(*fair) : nlohmann::json(nullptr)},
           {"chi2_heads_tails", coin ? chi2_json(*coin) : nlohmann::json(nullptr)},
           {"bounces_per_toss", r.tosses ? static_cast<double>(r.counts.bounces) / static_cast<double>(r.tosses) : 0.0},
           {"corrections", corrections_json(r.counts.corrections)},
@@ -151,9 +186,24 @@ std::string report_table(const RunReport& r) {
     std::snprintf(line, sizeof line, "chi-square vs %s: %.2f on %d dof, p = %.3g\n", against, c.statistic, c.dof, c.p_value);
     out += line;
   };
-  const auto coin = chi2_heads_tails(r);
-  if (coin) chi_line("a fair coin (heads = tails, edge landings left out)", *coin);
-  chi_line(coin ? "heads, tails and edge equally likely" : "a fair die", chi2_fair(r));
+  const std::vector<AlikeTest> tests = alike_tests(r);
+  const auto fair = chi2_fair(r, tests);
+  if (fair) {
+    chi_line("a fair die (every outcome alike by its symmetry)", *fair);
+  } else if (const auto coin = chi2_heads_tails(tests)) {
+    chi_line("a fair coin (heads = tails, edge landings left out)", *coin);
+  } else if (!tests.empty()) {
+    out += "chi-square within the outcomes alike by the die's symmetry (equal by design; the groups are not alike):\n";
+    for (const AlikeTest& t : tests) {
+      std::snprintf(line, sizeof line, "  %-24s %.2f on %d dof, p = %.3g\n", labels_text(t.labels).c_str(), t.chi.statistic,
+                    t.chi.dof, t.chi.p_value);
+      out += line;
+    }
+  } else if (r.alike.empty()) {
+    out += "no chi-square test: which outcomes are alike by design is not known here (the run's model is not at hand)\n";
+  } else {
+    out += "no chi-square test: no two outcomes are alike by design (" + r.alike_note + ")\n";
+  }
   std::snprintf(line, sizeof line, "%.3f s, %.0f tosses/s, %.2f impacts per toss\n", r.elapsed_s, rate(r),
                 r.tosses ? static_cast<double>(r.counts.bounces) / static_cast<double>(r.tosses) : 0.0);
   out += line;
@@ -201,6 +251,9 @@ void set_labels(RunReport& r, const DieModel& m) {
   r.faces_per_label.assign(m.outcome_labels.size(), 0);
   for (const int k : m.face_outcome) ++r.faces_per_label[static_cast<std::size_t>(k)];
   r.names = outcome_names(m);
+  r.alike = m.outcome_alike;
+  r.symmetry_rotations = m.symmetry_rotations;
+  r.alike_note = m.alike_note;
 }
 
 void print_report(const RunReport& r, bool json) {

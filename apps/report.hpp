@@ -27,6 +27,11 @@ struct RunReport {
   // Per outcome (counts.faces order), a coin's side names: "heads", "tails", "edge" ("heads/tails"
   // when labels group them). Empty for a die.
   std::vector<std::string> names;
+  // Per outcome, the index of the first outcome of its class of outcomes alike by design
+  // (DieModel::outcome_alike); empty: unknown, no test. The rotations and the note say why.
+  std::vector<int> alike;
+  int symmetry_rotations = 1;
+  std::string alike_note;
   double elapsed_s = 0.0;
   Provenance provenance;  // what made it ("provenance" in JSON, the header's lines in the table)
   // Interrupted (SIGINT/SIGTERM): `tosses` is the longest complete prefix 0..tosses-1 of the
@@ -40,14 +45,17 @@ struct RunReport {
 };
 
 // {"scene", "fidelity", "seed", "threads", "tosses", "settled", "unresolved", "invalid",
-//  "faces": [{"face", "count", "p", "ci95": [lo, hi]} (a coin's also "name": heads, tails, edge)], "chi2_uniform": {"statistic", "dof", "p_value"},
-//  "chi2_heads_tails": a coin's heads against tails, edge landings left out (1 dof; null for a die),
+//  "faces": [{"face", "count", "p", "ci95": [lo, hi]} (a coin's also "name": heads, tails, edge)],
+//  "alike": {"groups": [[labels of outcomes alike by design], ...] (two or more each), "rotations", "note"},
+//  "chi2_alike": [{"outcomes": [labels], "statistic", "dof", "p_value"}] (one per group: equal
+//  probabilities within it), "chi2_uniform": the same when every outcome is alike (a fair die),
+//  else null; "chi2_heads_tails": a coin's group of heads and tails (edge landings left out), else null,
 //  "corrections": {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks", "located_capped",
-//  "support_search_capped", "rise_dropped", "depth_held", "nudges"} (totals over the run; the table
-//  prints a line only when one is non-zero), "elapsed_s", "tosses_per_s"} -- p and
+//  "support_search_capped", "rise_dropped", "depth_held", "nudges"} (totals over the run; the table prints a line only when one is non-zero), "elapsed_s", "tosses_per_s"} -- p and
 //  intervals over settled tosses; "partial": true when interrupted (then "tosses" is the complete
-//  prefix run, "tosses_requested" what was asked), "tosses_requested", "provenance" (provenance.hpp); faces by label (N outcomes; chi-square on N - 1 dof against every
-//  face equally likely, grouped labels weighted by their faces).
+//  prefix run, "tosses_requested" what was asked), "tosses_requested", "provenance" (provenance.hpp); faces by label.
+//  Outcomes not alike by design are never tested against each other (sim/body/symmetry.hpp says
+//  when they are alike).
 nlohmann::json report_json(const RunReport& r);
 // A number, or null when it is not finite (JSON has no NaN or infinity; Python then sees None).
 nlohmann::json json_number(double v);

@@ -331,11 +331,20 @@ void register_toss(pb::module_& m) {
           "'corrections' object (None if this build's report has none).")
       .def_property_readonly(
           "chi2_uniform", [](Result& r) { return r.field("chi2_uniform"); },
-          "Pearson chi-square against a fair die: {'statistic', 'dof', 'p_value'}.")
+          "Pearson chi-square against a fair die: {'statistic', 'dof', 'p_value'}; None unless every\n"
+          "outcome is alike by the die's symmetry (see `alike`).")
       .def_property_readonly(
           "chi2_heads_tails", [](Result& r) { return r.field("chi2_heads_tails"); },
           "A coin's heads against tails, edge landings left out (1 dof): {'statistic', 'dof', 'p_value'};\n"
-          "None for a die.")
+          "None for a die, or a coin that is not the same turned over.")
+      .def_property_readonly(
+          "alike", [](Result& r) { return r.field("alike"); },
+          "Outcomes alike by design: {'groups': [[labels], ...], 'rotations', 'note'} (the rotations that\n"
+          "carry the die, shape and materials, onto itself and the throw keeps).")
+      .def_property_readonly(
+          "chi2_alike", [](Result& r) { return r.field("chi2_alike"); },
+          "Per group of alike outcomes, its chi-square against equal probabilities:\n"
+          "[{'outcomes', 'statistic', 'dof', 'p_value'}].")
       .def_property_readonly(
           "elapsed_s", [](const Result& r) { return r.report().elapsed_s; }, "Wall-clock time of the run (s).")
       .def_property_readonly(

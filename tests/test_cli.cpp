@@ -41,8 +41,12 @@ TEST(Cli, TossJsonIsOneObjectWithEveryKey) {
     EXPECT_GE(f["ci95"][1].get<double>(), f["p"].get<double>());
   }
   EXPECT_EQ(sum, j["settled"].get<int>());
-  EXPECT_TRUE(j["chi2_uniform"].contains("statistic"));
-  EXPECT_TRUE(j["chi2_uniform"].contains("p_value"));
+  // Die 1 is loaded along z: only its sides 2-5 are alike, so no test against a fair die.
+  EXPECT_TRUE(j["chi2_uniform"].is_null());
+  ASSERT_EQ(j["chi2_alike"].size(), 1u);
+  EXPECT_EQ(j["chi2_alike"][0]["outcomes"], nlohmann::json({2, 3, 4, 5}));
+  EXPECT_TRUE(j["chi2_alike"][0].contains("statistic"));
+  EXPECT_TRUE(j["chi2_alike"][0].contains("p_value"));
 }
 
 // A coin is fair when heads and tails are equally likely: that test leaves its edge landings out
@@ -62,7 +66,9 @@ TEST(Cli, ACoinIsTestedHeadsAgainstTails) {
   const auto& c = j["chi2_heads_tails"];
   EXPECT_EQ(c["dof"], 1);
   EXPECT_NEAR(c["statistic"].get<double>(), (heads - tails) * (heads - tails) / (heads + tails), 1e-9);
-  EXPECT_EQ(j["chi2_uniform"]["dof"], 2);
+  EXPECT_TRUE(j["chi2_uniform"].is_null()) << "heads, tails and edge are not alike: no test against all three equal";
+  EXPECT_EQ(j["chi2_alike"].size(), 1u);
+  EXPECT_EQ(j["chi2_alike"][0]["outcomes"], nlohmann::json({1, 2}));
   const CliRun table = cli("toss scenes/coins/quarter.toml --tosses 2000 --seed 3");
   EXPECT_NE(table.out.find("chi-square vs a fair coin (heads = tails, edge landings left out)"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("   heads\n"), std::string::npos) << table.out;

@@ -65,6 +65,15 @@ struct DieModel {
   // Per face f lying on the floor: the face that is read (f itself when read_down, else the face
   // whose normal points most nearly up).
   std::vector<int> face_result;
+  // Faces on which the die rests with no single face most nearly up (several of different labels
+  // tie, e.g. a corner cut off a 3-fold symmetric die): each is read as its own label, so
+  // face_result[f] == f (sim/models/compile.cpp states the rule). Empty when there are none.
+  std::vector<int> own_read_faces;
+  // Outcomes alike by design (sim/body/symmetry.hpp): per outcome, the index of the first outcome
+  // of its class; the rotations that carry the die onto itself and the throw keeps; how found.
+  std::vector<int> outcome_alike;
+  int symmetry_rotations = 1;
+  std::string alike_note;
 
   // Mass properties.
   double mass = 0.0;

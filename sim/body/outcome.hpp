@@ -9,13 +9,24 @@
 
 namespace dicesim {
 
-// Index of the face most aligned with +z (read_down: with -z) for body->world rotation R.
-// Ties go to the lower index (deterministic).
+// Index of the face most aligned with +z (read_down: with -z) for body->world rotation R; a die
+// lying on a face that is read as its own (DieModel::own_read_faces) reads that face. Exact ties
+// (measure zero) go to the lower index.
 inline int read_face_index(const DieModel& m, const Mat3& R) {
   if (m.curved()) {  // heads (0), tails (1), or the side (2): whose outward normal is most nearly up
     const double kz = R.row(2).dot(m.rims.axis);
     if (kz * kz >= 0.5) return kz > 0.0 ? 0 : 1;
     return 2;
+  }
+  if (!m.own_read_faces.empty() && !m.read_down) {
+    int down = 0;
+    double down_z = 2.0;
+    for (int f = 0; f < m.face_count(); ++f)
+      if (const double z = R.row(2).dot(m.face_normals[static_cast<std::size_t>(f)]); z < down_z) {
+        down_z = z;
+        down = f;
+      }
+    if (m.face_result[static_cast<std::size_t>(down)] == down) return down;
   }
   int best = 0;
   double best_z = -2.0;
@@ -50,6 +61,26 @@ inline std::vector<std::string> outcome_names(const DieModel& m) {
     name += kCylinderOutcomeNames[f];
   }
   return names;
+}
+
+// The label read when the die rests on face f (the face up, the face down, or f's own label:
+// DieModel::own_read_faces).
+inline int resting_outcome_label(const DieModel& m, int f) {
+  const int g = m.face_result[static_cast<std::size_t>(f)];
+  return m.outcome_labels[static_cast<std::size_t>(m.face_outcome[static_cast<std::size_t>(g)])];
+}
+
+// The classes of two or more outcomes alike by design (DieModel::outcome_alike), as labels.
+inline std::vector<std::vector<int>> alike_groups(const DieModel& m) {
+  std::vector<std::vector<int>> groups;
+  for (std::size_t first = 0; first < m.outcome_alike.size(); ++first) {
+    if (m.outcome_alike[first] != static_cast<int>(first)) continue;
+    std::vector<int> g;
+    for (std::size_t k = first; k < m.outcome_alike.size(); ++k)
+      if (m.outcome_alike[k] == static_cast<int>(first)) g.push_back(m.outcome_labels[k]);
+    if (g.size() > 1) groups.push_back(std::move(g));
+  }
+  return groups;
 }
 
 }  // namespace dicesim

@@ -10,6 +10,7 @@
 
 #include "sim/body/body.hpp"
 #include "sim/body/rim.hpp"
+#include "sim/body/symmetry.hpp"
 #include "sim/dynamics/rim_rest.hpp"
 #include "sim/models/fidelity_auto.hpp"
 #include "sim/dynamics/rest.hpp"
@@ -104,6 +105,62 @@ void build_outcomes(DieModel& m) {
   }
 }
 
+// The tie rule (a die read up). Resting on face f, the face read is the one whose outward normal
+// is most nearly opposite f's. When several faces tie for that (cosines within 1e-9) and their
+// labels differ, no face is up: the die lies with an edge or a corner on top, as on a corner cut
+// off a 3-fold symmetric die. Such a face f that can hold the die is then read as its own label
+// (it gets its own outcome), provided that label is f's alone and f is not also the face read
+// from another resting face; otherwise the scene must settle it (a label of its own for f, one
+// label for the tied faces, or read = "down"), and is refused naming the face. Never by index.
+void resolve_read_ties(DieModel& m, const std::string& origin) {
+  if (m.read_down || m.curved()) return;
+  const int nf = m.face_count();
+  auto normal_text = [&](int f) {
+    const Vec3 n = m.geo_to_body.transpose() * m.face_normals[static_cast<std::size_t>(f)];
+    return "(" + fmt(n.x()) + ", " + fmt(n.y()) + ", " + fmt(n.z()) + ")";
+  };
+  for (int f = 0; f < nf; ++f) {
+    const std::size_t fi = static_cast<std::size_t>(f);
+    if (m.face_hold[fi] < 0.0) continue;  // the die never rests on it
+    const Vec3& n = m.face_normals[fi];
+    const double best = n.dot(m.face_normals[static_cast<std::size_t>(m.face_result[fi])]);
+    std::vector<int> tied;
+    bool differ = false;
+    for (int g = 0; g < nf; ++g)
+      if (n.dot(m.face_normals[static_cast<std::size_t>(g)]) <= best + 1e-9) {
+        tied.push_back(g);
+        differ = differ || m.face_labels[static_cast<std::size_t>(g)] != m.face_labels[static_cast<std::size_t>(tied.front())];
+      }
+    if (!differ) continue;
+    bool own = std::count(m.face_labels.begin(), m.face_labels.end(), m.face_labels[fi]) == 1;
+    for (int h = 0; h < nf && own; ++h)
+      own = !(h != f && m.face_hold[static_cast<std::size_t>(h)] >= 0.0 && m.face_result[static_cast<std::size_t>(h)] == f);
+    if (!own) {
+      std::string faces, labels;
+      for (const int g : tied) {
+        faces += (faces.empty() ? "" : ", ") + std::to_string(g);
+        labels += (labels.empty() ? "" : ", ") + std::to_string(m.face_labels[static_cast<std::size_t>(g)]);
+      }
+      throw SceneError(origin, "die.labels", "face " + std::to_string(f) + " (label " + std::to_string(m.face_labels[fi]) +
+                           ", outward normal " + normal_text(f) + ")",
+                       "resting on it, faces " + faces + " (labels " + labels +
+                           ") are equally near up, so no face is read; give it a label of its own (a [[die.labels]] "
+                           "entry with its normal; it is then read as that label), give those faces one label, or "
+                           "read = \"down\"");
+    }
+    m.own_read_faces.push_back(f);
+  }
+  for (const int f : m.own_read_faces) m.face_result[static_cast<std::size_t>(f)] = f;
+}
+
+// The outcomes the die's symmetry makes alike (sim/body/symmetry.hpp).
+void find_alike_outcomes(DieModel& m, const Body& body, const SceneDef& scene) {
+  const DieSymmetry sym = die_symmetry(body, scene);
+  m.outcome_alike = alike_outcome_classes(body, sym.rotations);
+  m.symmetry_rotations = static_cast<int>(sym.rotations.size());
+  m.alike_note = sym.note;
+}
+
 // Settings, fidelity, and the check that the die starts above the floor (every shape).
 void finish_model(DieModel& m, const SceneDef& scene, const std::string& origin) {
   m.gravity = scene.sim.gravity;
@@ -194,6 +251,7 @@ DieModel compile_cylinder(const Body& body, const SceneDef& scene, const std::st
   build_outcomes(m);
   m.face_result = {1, 0, 2};  // heads face down shows tails, tails face down heads, the side edge
   compute_rim_rest_geometry(m);
+  find_alike_outcomes(m, body, scene);
   m.max_friction = *std::max_element(m.vertex_friction.begin(), m.vertex_friction.end());
   finish_model(m, scene, origin);
   return m;
@@ -237,6 +295,8 @@ DieModel compile_body(const Body& body, const SceneDef& scene, const std::string
   build_outcomes(m);
 
   compute_rest_geometry(m);
+  resolve_read_ties(m, origin);
+  find_alike_outcomes(m, body, scene);
   m.max_friction = *std::max_element(m.vertex_friction.begin(), m.vertex_friction.end());
 
   finish_model(m, scene, origin);

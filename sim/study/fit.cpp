@@ -10,6 +10,7 @@
 #include <thread>
 
 #include <Eigen/Dense>
+#include <boost/math/distributions/normal.hpp>
 
 #include "sim/body/outcome.hpp"
 #include "sim/models/compile.hpp"
@@ -214,6 +215,8 @@ class Fitter {
                           int skip_batch) const;
   FitParamResult profile_param(int i, const Surrogate& sur, const Box& box, const VectorXd& theta, double lmax,
                                double mc_sd) const;
+  void check_identifiable(FitParamResult& pr, int i, const std::vector<VectorXd>& design,
+                          const std::vector<std::vector<PointCounts>>& counts) const;
   double loglik(const Surrogate& sur, const VectorXd& theta) const {
     double l = 0.0;
     for (std::size_t s = 0; s < data_.size(); ++s) l += n_[s].dot(sur.log_p(s, theta));
@@ -384,8 +387,10 @@ FitParamResult Fitter::profile_param(int i, const Surrogate& sur, const Box& box
   };
   bool lo_open = false, hi_open = false;
   pr.ci95_profile = {end_on(-1, lo_open), end_on(+1, hi_open)};
-  pr.lo_open = lo_open && blo <= params_[ii].lo;
-  pr.hi_open = hi_open && bhi >= params_[ii].hi;
+  pr.lo_open = lo_open;  // run() widens a narrowed box whose edge the set reaches
+  pr.hi_open = hi_open;
+  pr.box_lo = blo;
+  pr.box_hi = bhi;
   pr.estimate = theta[i];
   pr.mc_sd = mc_sd;
   const double z = kZ95 * pr.mc_sd;
@@ -393,6 +398,61 @@ FitParamResult Fitter::profile_param(int i, const Surrogate& sur, const Box& box
   pr.ci95.hi = std::min(params_[ii].hi, pr.estimate + std::hypot(pr.ci95_profile.hi - pr.estimate, z));
   pr.mc_large = pr.mc_sd > 0.5 * (pr.ci95_profile.hi - pr.ci95_profile.lo) / (2.0 * kZ95);
   return pr;
+}
+
+// Does key i move any outcome's probability by more than the Monte Carlo noise? Every pair of
+// design points that differ in key i alone, every data set and outcome: the difference of the
+// two frequencies, and its standard error from the batches (each batch is the same toss indices at
+// both points, so the common random numbers' correlation is in it). The key is identifiable when
+// some |difference| exceeds z * se, z the two-sided 95% level Bonferroni-corrected for the number
+// of comparisons (a difference with se = 0 counts when it is not 0).
+void Fitter::check_identifiable(FitParamResult& pr, int i, const std::vector<VectorXd>& design,
+                                const std::vector<std::vector<PointCounts>>& counts) const {
+  struct Cmp {
+    std::size_t s, a, b, k;
+  };
+  std::vector<Cmp> cmps;
+  for (std::size_t a = 0; a < design.size(); ++a)
+    for (std::size_t b = a + 1; b < design.size(); ++b) {
+      bool only_i = design[a][i] != design[b][i];
+      for (int j = 0; j < d_ && only_i; ++j) only_i = j == i || design[a][j] == design[b][j];
+      if (!only_i) continue;
+      for (std::size_t s = 0; s < counts.size(); ++s)
+        for (std::size_t k = 0; k < labels_[s].size(); ++k) cmps.push_back({s, a, b, k});
+    }
+  const double alpha = 0.05 / static_cast<double>(std::max<std::size_t>(cmps.size(), 1));
+  pr.shift_z_level = boost::math::quantile(boost::math::complement(boost::math::normal(), alpha / 2.0));
+  pr.shift_z = 0.0;
+  pr.identifiable = false;
+  for (const Cmp& c : cmps) {
+    const PointCounts& A = counts[c.s][c.a];
+    const PointCounts& B = counts[c.s][c.b];
+    const std::size_t nb = A.settled.size();
+    std::vector<double> diff;
+    double ca = 0.0, na = 0.0, cb = 0.0, nbt = 0.0;
+    for (std::size_t t = 0; t < nb; ++t) {
+      ca += static_cast<double>(A.faces[t][c.k]);
+      na += static_cast<double>(A.settled[t]);
+      cb += static_cast<double>(B.faces[t][c.k]);
+      nbt += static_cast<double>(B.settled[t]);
+      if (A.settled[t] && B.settled[t])
+        diff.push_back(static_cast<double>(B.faces[t][c.k]) / static_cast<double>(B.settled[t]) -
+                       static_cast<double>(A.faces[t][c.k]) / static_cast<double>(A.settled[t]));
+    }
+    if (na <= 0.0 || nbt <= 0.0 || diff.size() < 2) continue;
+    const double d = cb / nbt - ca / na;
+    double mean = 0.0, var = 0.0;
+    for (const double x : diff) mean += x / static_cast<double>(diff.size());
+    for (const double x : diff) var += (x - mean) * (x - mean) / static_cast<double>(diff.size() - 1);
+    const double se = std::sqrt(var / static_cast<double>(diff.size()));
+    if (se > 0.0) {
+      pr.shift_z = std::max(pr.shift_z, std::abs(d) / se);
+      if (std::abs(d) > pr.shift_z_level * se) pr.identifiable = true;
+    } else if (d != 0.0) {
+      pr.shift_z = std::numeric_limits<double>::infinity();
+      pr.identifiable = true;
+    }
+  }
 }
 
 FitResult Fitter::run() {
@@ -449,6 +509,17 @@ FitResult Fitter::run() {
                          "the die of " + data_[s].scene + " has no such outcome; its outcomes: " + labels_text(labels_[s]));
       n[it - labels_[s].begin()] += static_cast<double>(obs.counts[i]);
     }
+    // The data must be of this die: every outcome it has named (a count of 0 when never seen).
+    std::vector<int> missing;
+    for (const int l : labels_[s])
+      if (std::find(obs.labels.begin(), obs.labels.end(), l) == obs.labels.end()) missing.push_back(l);
+    if (!missing.empty()) {
+      std::vector<int> given = obs.labels;
+      std::sort(given.begin(), given.end());
+      throw SceneError(data_[s].source, "face", labels_text(given),
+                       "these outcome labels are not those of the die of " + data_[s].scene + " (" + labels_text(labels_[s]) +
+                           "): " + labels_text(missing) + " missing; list every outcome of the die, with count 0 if never seen");
+    }
     if (n.sum() <= 0.0) throw SceneError(data_[s].source, "counts", "", "all counts are 0");
     n_.push_back(n);
   }
@@ -459,6 +530,7 @@ FitResult Fitter::run() {
   Surrogate sur{Basis(d_, 0), box, {}};
   std::vector<std::vector<PointCounts>> counts;
   VectorXd theta(d_);
+  int widenings = 0;
   for (int r = 0; r < R; ++r) {
     if (r > 0) {
       for (std::size_t s = 0; s < S; ++s) {
@@ -469,6 +541,46 @@ FitResult Fitter::run() {
     const std::string stage = "round " + std::to_string(r + 1) + "/" + std::to_string(R);
     counts.assign(S, {});
     for (std::size_t s = 0; s < S; ++s) counts[s] = simulate(models[s], round_tosses(r), stage);
+    if (r == 0) {
+      // A key that moves no outcome beyond the noise cannot be fitted: say so, estimate nothing.
+      res.params.clear();
+      for (int i = 0; i < d_; ++i) {
+        FitParamResult pr;
+        pr.key = params_[static_cast<std::size_t>(i)].key;
+        pr.lo = pr.box_lo = params_[static_cast<std::size_t>(i)].lo;
+        pr.hi = pr.box_hi = params_[static_cast<std::size_t>(i)].hi;
+        check_identifiable(pr, i, design, counts);
+        res.params.push_back(pr);
+      }
+      res.estimated = std::any_of(res.params.begin(), res.params.end(), [](const FitParamResult& p) { return p.identifiable; });
+      if (!res.estimated) {
+        constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+        for (FitParamResult& pr : res.params) {
+          pr.estimate = pr.mc_sd = pr.fisher_halfwidth = nan;
+          pr.ci95 = pr.ci95_profile = {nan, nan};
+        }
+        FitRound fr;
+        fr.box_lo = box.lo;
+        fr.box_hi = box.hi;
+        fr.points = design.size();
+        fr.tosses_per_point = round_tosses(r);
+        res.rounds.push_back(fr);
+        res.loglik = nan;
+        res.gof = {nan, 0, nan};
+        for (std::size_t s = 0; s < S; ++s) {
+          FitDataResult dr;
+          dr.scene = data_[s].scene;
+          dr.source = data_[s].source;
+          dr.labels = labels_[s];
+          for (Eigen::Index k = 0; k < n_[s].size(); ++k) dr.observed.push_back(static_cast<std::uint64_t>(n_[s][k]));
+          dr.gof = {nan, 0, nan};
+          res.data.push_back(std::move(dr));
+        }
+        res.simulated_tosses = simulated_;
+        res.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        return res;
+      }
+    }
     sur = fit_surrogate(box, design, counts, -1);
     double lmax = 0.0;
     theta = maximize([&](const VectorXd& x) { return loglik(sur, x); }, box, &lmax);
@@ -490,16 +602,50 @@ FitResult Fitter::run() {
     const VectorXd mc_sd = (var * (static_cast<double>(B - 1) / B)).cwiseSqrt();
 
     // Profiles: each parameter on a grid over the box, the others maximised.
+    std::vector<FitParamResult> checked = std::move(res.params);
     res.params.clear();
-    for (int i = 0; i < d_; ++i) res.params.push_back(profile_param(i, sur, box, theta, lmax, mc_sd[i]));
+    for (int i = 0; i < d_; ++i) {
+      res.params.push_back(profile_param(i, sur, box, theta, lmax, mc_sd[i]));
+      if (static_cast<std::size_t>(i) < checked.size()) {
+        res.params.back().identifiable = checked[static_cast<std::size_t>(i)].identifiable;
+        res.params.back().shift_z = checked[static_cast<std::size_t>(i)].shift_z;
+        res.params.back().shift_z_level = checked[static_cast<std::size_t>(i)].shift_z_level;
+      }
+    }
     FitRound fr;
     fr.box_lo = box.lo;
     fr.box_hi = box.hi;
     fr.points = design.size();
     fr.tosses_per_point = round_tosses(r);
     for (int i = 0; i < d_; ++i) fr.estimate.push_back(theta[i]);
-    res.rounds.push_back(fr);
     res.loglik = lmax;
+
+    // A set reaching a narrowed box's edge was cut off by the box, not bounded by the data: widen
+    // that side (by the box's width, within LO..HI) and refit this round.
+    Box wider = box;
+    bool widen = false;
+    for (int i = 0; i < d_; ++i) {
+      const auto ii = static_cast<std::size_t>(i);
+      const double w = box.hi[ii] - box.lo[ii];
+      if (res.params[ii].lo_open && box.lo[ii] > range.lo[ii]) {
+        wider.lo[ii] = std::max(range.lo[ii], box.lo[ii] - w);
+        widen = true;
+      }
+      if (res.params[ii].hi_open && box.hi[ii] < range.hi[ii]) {
+        wider.hi[ii] = std::min(range.hi[ii], box.hi[ii] + w);
+        widen = true;
+      }
+    }
+    fr.widened = widen && widenings < kFitMaxWidenings;
+    res.rounds.push_back(fr);
+    if (fr.widened) {
+      ++widenings;
+      box = wider;
+      design = grid(box);
+      total_ += round_tosses(r) * design.size() * S;
+      --r;  // the same round again, in the wider box (its models are compiled at the loop's top)
+      continue;
+    }
 
     if (r + 1 < R) {  // the next box: the interval widened 2.5x about the estimate, inside LO..HI
       Box next;
@@ -531,10 +677,28 @@ FitResult Fitter::run() {
     }
     for (Eigen::Index k = 0; k < p.size(); ++k) info += n_[s].sum() * grad.row(k).transpose() * grad.row(k) / p[k];
   }
-  const Eigen::FullPivLU<MatrixXd> lu(info);
-  const MatrixXd cov = lu.isInvertible() ? MatrixXd(lu.inverse()) : MatrixXd::Constant(d_, d_, std::numeric_limits<double>::quiet_NaN());
+  // Over the identifiable keys only; the others get no estimate or interval.
+  std::vector<int> known;
   for (int i = 0; i < d_; ++i)
-    res.params[static_cast<std::size_t>(i)].fisher_halfwidth = cov(i, i) > 0.0 ? kZ95 * std::sqrt(cov(i, i)) : std::numeric_limits<double>::quiet_NaN();
+    if (res.params[static_cast<std::size_t>(i)].identifiable) known.push_back(i);
+  MatrixXd sub(static_cast<Eigen::Index>(known.size()), static_cast<Eigen::Index>(known.size()));
+  for (std::size_t a = 0; a < known.size(); ++a)
+    for (std::size_t b = 0; b < known.size(); ++b)
+      sub(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = info(known[a], known[b]);
+  const Eigen::FullPivLU<MatrixXd> lu(sub);
+  const auto nk = static_cast<Eigen::Index>(known.size());
+  const MatrixXd cov = lu.isInvertible() ? MatrixXd(lu.inverse()) : MatrixXd::Constant(nk, nk, std::numeric_limits<double>::quiet_NaN());
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  for (FitParamResult& pr : res.params) pr.fisher_halfwidth = nan;
+  for (std::size_t a = 0; a < known.size(); ++a) {
+    const double v = cov(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a));
+    res.params[static_cast<std::size_t>(known[a])].fisher_halfwidth = v > 0.0 ? kZ95 * std::sqrt(v) : nan;
+  }
+  for (FitParamResult& pr : res.params)
+    if (!pr.identifiable) {
+      pr.estimate = pr.mc_sd = nan;
+      pr.ci95 = pr.ci95_profile = {nan, nan};
+    }
 
   // The fitted probabilities: simulated at the estimate, with the goodness of fit.
   double stat = 0.0;

@@ -83,8 +83,20 @@ struct FitParamResult {
   Interval ci95_profile;        // the surrogate's profile likelihood alone
   double mc_sd = 0.0;           // Monte Carlo standard deviation of the estimate (jackknife)
   double fisher_halfwidth = 0;  // the ideal 95% half-width, 1.96 sqrt((I^-1)_ii), NaN if I is singular
-  bool lo_open = false;         // the interval reaches LO (or HI): the data do not bound it there
+  // The confidence set reaches the end of the box searched: the data do not bound it there. That
+  // box is LO..HI, or a narrowed one that was widened as far as kFitMaxWidenings allow (box_lo,
+  // box_hi: the last round's box). Never an end cut off by a narrowed box and called closed.
+  bool lo_open = false;
   bool hi_open = false;
+  double box_lo = 0.0, box_hi = 0.0;
+  // Whether the key moves some outcome's probability by more than the Monte Carlo noise over its
+  // range (round 1's design: every pair of points differing in this key alone, every outcome;
+  // |difference| / its batch standard error against a Bonferroni-corrected 95% normal level).
+  // false: "not identifiable from these data", no estimate or interval (NaN; the other keys are
+  // fitted with it free over its range, and the ideal half-widths leave it out).
+  bool identifiable = true;
+  double shift_z = 0.0;         // the largest |difference| / standard error found
+  double shift_z_level = 0.0;   // the level it must exceed
   bool mc_large = false;        // mc_sd above half the profile's sd: raise the tosses
   std::vector<std::array<double, 2>> profile;  // (value, 2 (l_max - l_profile)) over the last box
 };
@@ -99,8 +111,13 @@ struct FitDataResult {
   ChiSquare gof;                        // this data set against `fitted`, dof = outcomes - 1
 };
 
+// A narrowed box whose confidence set reaches its edge is widened and the round refitted, at most
+// this many times in a fit; after that the end is reported open.
+inline constexpr int kFitMaxWidenings = 4;
+
 struct FitRound {
   std::vector<double> box_lo, box_hi;   // per parameter
+  bool widened = false;                 // its set reached a narrowed edge: refitted in a wider box
   std::uint64_t points = 0, tosses_per_point = 0;
   std::vector<double> estimate;
 };
@@ -115,10 +132,12 @@ struct FitResult {
   std::uint64_t simulated_tosses = 0;
   double elapsed_s = 0.0;
   std::vector<FitRound> rounds;
+  bool estimated = true;  // false: no key is identifiable (FitParamResult::identifiable); the fit
+                          // stopped after round 1 with no estimate, interval or fitted probabilities
 };
 
 // Validates first (1-3 distinct parameters, every scene loading at each parameter's LO and HI,
-// observed labels that the die has, counts not all zero: SceneError naming the file or key), then
+// observed labels exactly the die's outcomes, counts not all zero: SceneError naming the file or key), then
 // fits. Throws std::runtime_error("cancelled") if `cancel` was set.
 FitResult run_fit(const std::vector<FitParam>& params, const std::vector<FitData>& data, const FitOptions& opt);
 
