@@ -97,6 +97,8 @@ int run_cli(int argc, char** argv) {
   register_watch(app, exit_code);
   register_record(app, exit_code);
   register_replay(app, exit_code);
+  register_merge(app, exit_code);
+  register_hub(app, exit_code);
   return parse_and_run(app, argc, argv, exit_code);
 }
 

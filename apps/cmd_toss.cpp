@@ -1,12 +1,14 @@
 // dicesim toss: Monte Carlo probabilities of each face, in this process.
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <thread>
 
 #include "aggregator/target.hpp"
 #include "apps/commands.hpp"
 #include "apps/progress.hpp"
 #include "apps/report.hpp"
+#include "apps/shard_file.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/study/monte_carlo.hpp"
@@ -22,21 +24,50 @@ struct TossArgs {
   bool json = false;
   double target_halfwidth = 0.0;
   CLI::Option* tosses_opt = nullptr;
+  std::string shard;  // --shard I/N
+  std::string out;    // --out FILE: the shard file for `dicesim merge`
 };
 
 int run_toss(const TossArgs& a) {
   const SceneDef def = a.scene.load();
   const DieModel model = compile(def, a.scene.path);
+  Shard shard;
+  if (!a.shard.empty()) {
+    try {
+      shard = parse_shard(a.shard);
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "dicesim: error: --shard %s\n", e.what());
+      return kExitBadInput;
+    }
+  }
+  if ((!a.shard.empty() || !a.out.empty()) && a.target_halfwidth > 0.0) {
+    std::fprintf(stderr, "dicesim: error: --shard/--out and --target-halfwidth exclude each other (a shard tosses a fixed block)\n");
+    return kExitBadInput;
+  }
+  std::ofstream out_file;
+  if (!a.out.empty()) {
+    out_file.open(a.out);
+    if (!out_file) {
+      std::fprintf(stderr, "dicesim: error: --out %s: cannot write it\n", a.out.c_str());
+      return kExitBadInput;
+    }
+  }
+  // The whole run is a.tosses; this process tosses its block (all of it without --shard).
+  const IndexRange block = shard_range(a.tosses, shard);
+  std::vector<std::string> overrides = a.scene.overrides;
+  if (!a.scene.fidelity.empty()) overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
+  const ShardHeader header = a.out.empty() ? ShardHeader{} : make_shard_header(a.scene.path, overrides, model, a.tosses, shard);
 
   ProgressBar bar;
   RunConfig cfg;
   cfg.seed = a.seed;
-  cfg.tosses = a.tosses;
+  cfg.first = block.first;
+  cfg.tosses = block.tosses;
   cfg.threads = a.threads;
   cfg.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
 
   const auto t0 = std::chrono::steady_clock::now();
-  std::uint64_t tosses = a.tosses;
+  std::uint64_t tosses = block.tosses;
   const bool target = a.target_halfwidth > 0.0;
   // With a target and no explicit --tosses, N is only a generous cap.
   const std::uint64_t cap = target && a.tosses_opt->count() == 0 ? 1'000'000'000ULL : a.tosses;
@@ -57,6 +88,13 @@ int run_toss(const TossArgs& a) {
   r.counts = counts;
   set_labels(r, model);
   r.elapsed_s = elapsed;
+  if (!a.out.empty()) {
+    out_file << shard_json(r, header).dump() << '\n';
+    if (!out_file.flush()) {
+      std::fprintf(stderr, "dicesim: failed: cannot write --out %s\n", a.out.c_str());
+      return kExitFailed;
+    }
+  }
   print_report(r, a.json);
   return kExitOk;
 }
@@ -74,7 +112,8 @@ void register_toss(CLI::App& app, int& exit_code) {
       "  dicesim toss scenes/paper/die1.toml\n"
       "  dicesim toss scenes/paper/die1.toml --tosses 1000000 --threads 2 --json\n"
       "  dicesim toss scenes/fair.toml --set throw.height.mean=0.5 --set sim.stop_speed=0.01\n"
-      "  dicesim toss scenes/paper/die3.toml --target-halfwidth 0.002   # as many tosses as that takes");
+      "  dicesim toss scenes/paper/die3.toml --target-halfwidth 0.002   # as many tosses as that takes\n"
+      "  dicesim toss scenes/paper/die1.toml -n 1000000 --shard 3/16 --out part-3.json   # then: dicesim merge part-*.json");
   args->scene.add_to(cmd);
   args->tosses_opt = cmd->add_option("-n,--tosses", args->tosses, "Number of tosses (with --target-halfwidth: the most it may take)")
                          ->capture_default_str()
@@ -89,6 +128,15 @@ void register_toss(CLI::App& app, int& exit_code) {
                   "(deterministic: the same stopping point on any number of threads or workers)")
       ->type_name("H")
       ->check(CLI::Range(1e-6, 0.5));
+  cmd->add_option("--shard", args->shard,
+                  "Toss shard I of N (I = 0..N-1) of the --tosses run: the contiguous index block\n"
+                  "[floor(T*I/N), floor(T*(I+1)/N)) of T tosses. `dicesim merge` adds N shards' --out files\n"
+                  "into the counts of one toss of all T (docs/scaling-out.md)")
+      ->type_name("I/N");
+  cmd->add_option("--out", args->out,
+                  "Also write the report as a shard file for `dicesim merge` (the --json report plus a \"shard\"\n"
+                  "object: version, scene hash, model fingerprint, block, raw counts); stdout is unchanged")
+      ->type_name("FILE");
   cmd->add_flag("--json", args->json, "Print exactly one JSON object on stdout instead of the table");
   cmd->callback([args, &exit_code] { exit_code = run_toss(*args); });
 }

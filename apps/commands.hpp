@@ -49,6 +49,8 @@ void register_bridge(CLI::App& app, int& exit_code);  // cmd_bridge.cpp
 void register_watch(CLI::App& app, int& exit_code);   // cmd_watch.cpp
 void register_record(CLI::App& app, int& exit_code);  // cmd_record.cpp
 void register_replay(CLI::App& app, int& exit_code);  // cmd_replay.cpp
+void register_merge(CLI::App& app, int& exit_code);   // cmd_merge.cpp: shards of `toss --shard`
+void register_hub(CLI::App& app, int& exit_code);     // cmd_hub.cpp: LCM's TCP hub
 
 // Distributed runs (cmd_aggregate.cpp): what `aggregate` and `run` share.
 struct AggregateArgs {
