@@ -154,10 +154,11 @@ TEST(CliShard, SweepPointsShardGivesTheWholeSweepsPoints) {
   for (const char* shard : {"0/2", "1/2"}) {
     const CliRun part = run_dicesim(base + " --points " + shard);
     ASSERT_EQ(part.code, 0) << part.err;
-    for (const auto& p : nlohmann::json::parse(part.out)["points"]) joined.push_back(p);
+    const nlohmann::json j = nlohmann::json::parse(part.out);
+    for (const auto& p : j["points"]) joined.push_back(p);
   }
   EXPECT_EQ(joined.size(), 5u);
   EXPECT_EQ(joined.dump(), nlohmann::json::parse(whole.out)["points"].dump());
   expect_bad_input(run_dicesim(base + " --points 2/2"), {"--points"});
-  expect_bad_input(run_dicesim(base + " --points 5/6"), {"--points", "no points"});
+  expect_bad_input(run_dicesim(base + " --points 0/10"), {"--points", "no points"});  // [0, floor(5/10)) is empty
 }
