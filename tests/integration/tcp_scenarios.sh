@@ -131,8 +131,9 @@ case "$scenario" in
     listening 3
     aggregate --key-file "$key" || fail "aggregate exited $?"
     same_as_reference "$work/out.json"
-    [ "$(health unauthenticated "$work/agg.err")" -gt 0 ] || grep -qiE "dropped|unauthenticated|seal" "$work/agg.err" ||
-      fail "the aggregator dropped nothing from the worker with another key"
+    dropped=$(health unauthenticated "$work/agg.err")
+    echo "unauthenticated messages dropped by the aggregator: $dropped"
+    [ "$dropped" -gt 0 ] || fail "the aggregator dropped nothing from the worker with another key"
     ;;
   run_tcp)
     n=100000
