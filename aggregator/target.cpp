@@ -22,8 +22,9 @@ RunCounts run_to_target(const DieModel& model, RunConfig cfg, std::uint64_t cap,
     cfg.tosses = std::min(kTargetBlock, cap - done);
     const std::uint64_t base = done;
     if (progress) cfg.progress = [&](std::uint64_t d, std::uint64_t) { progress(base + d, cap); };
-    total.merge(run_tosses(model, cfg));
-    done += cfg.tosses;
+    const RunCounts block = run_tosses(model, cfg);  // all of it, or a prefix when cancelled
+    total.merge(block);
+    done += block.total();
   }
   return total;
 }

@@ -1,10 +1,17 @@
 #include <cstdio>
+#include <algorithm>
+#include <cstdint>
 #include <exception>
 #include <string_view>
+#include <vector>
 
 #include "aggregator/checkpoint.hpp"
 #include "apps/commands.hpp"
+#include "apps/provenance.hpp"
+#include "apps/fidelity_name.hpp"
+#include "apps/number_forms.hpp"
 #include "messages/auth.hpp"
+#include "sim/scene/fidelity.hpp"
 #include "sim/scene/scene_error.hpp"
 
 namespace dicesim {
@@ -20,11 +27,19 @@ void SceneArgs::add_to(CLI::App* cmd) {
       ->type_name("F");
 }
 
-SceneDef SceneArgs::load() const {
-  std::vector<std::string> all = overrides;
-  if (!fidelity.empty()) all.push_back("sim.fidelity=\"" + fidelity + "\"");
-  return load_scene(path, all);
+void check_fidelity_name(const std::string& fidelity) {
+  if (!fidelity.empty() && !parse_fidelity(fidelity))
+    throw SceneError("--fidelity", "", "", "'" + fidelity + "' is not a fidelity; " + kFidelityChoices);
 }
+
+std::vector<std::string> SceneArgs::applied_overrides() const {
+  std::vector<std::string> all = overrides;
+  check_fidelity_name(fidelity);
+  if (!fidelity.empty()) all.push_back("sim.fidelity=\"" + fidelity + "\"");
+  return all;
+}
+
+SceneDef SceneArgs::load() const { return load_scene(path, applied_overrides()); }
 
 CLI::Option* add_key_file_option(CLI::App* cmd, std::string& path) {
   return cmd->add_option("--key-file", path,
@@ -47,6 +62,8 @@ int parse_and_run(CLI::App& app, int argc, char** argv, const int& exit_code) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "%s: %s\nRun with --help for usage.\n", app.get_name().c_str(), e.what());
     return kExitBadInput;
@@ -65,6 +82,44 @@ int parse_and_run(CLI::App& app, int argc, char** argv, const int& exit_code) {
   }
   return exit_code;
 }
+
+namespace {
+
+// Edits (insert, delete, replace, swap of neighbours) from a to b: how far a typo is from a command.
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
+  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i)
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  return d[a.size()][b.size()];
+}
+
+// `dicesim tos ...`: CLI11 would only say a subcommand is required. Name the word and the closest
+// command (a prefix counts as close: `dicesim sw` -> sweep).
+int unknown_command(const CLI::App& app, std::string_view word) {
+  std::string best;
+  std::size_t best_d = SIZE_MAX;
+  for (const CLI::App* sub : app.get_subcommands({})) {
+    const std::string& name = sub->get_name();
+    const std::size_t d = name.rfind(word, 0) == 0 ? 1 : edit_distance(word, name);
+    if (d < best_d) best_d = d, best = name;
+  }
+  std::string names;
+  for (const CLI::App* sub : app.get_subcommands({})) names += (names.empty() ? "" : ", ") + sub->get_name();
+  if (best_d <= std::max<std::size_t>(2, word.size() / 3))
+    std::fprintf(stderr, "dicesim: unknown command '%.*s'; did you mean '%s'?\nCommands: %s (dicesim --help)\n",
+                 static_cast<int>(word.size()), word.data(), best.c_str(), names.c_str());
+  else
+    std::fprintf(stderr, "dicesim: unknown command '%.*s'\nCommands: %s (dicesim --help)\n",
+                 static_cast<int>(word.size()), word.data(), names.c_str());
+  return kExitBadInput;
+}
+
+}  // namespace
 
 int run_cli(int argc, char** argv) {
   // `dicesim bench tradeoff SCENE` lives next to `dicesim bench SCENE` (whose SCENE is positional).
@@ -99,6 +154,14 @@ int run_cli(int argc, char** argv) {
   register_replay(app, exit_code);
   register_merge(app, exit_code);
   register_hub(app, exit_code);
+  register_version(app, exit_code);
+  app.set_version_flag("--version", std::string("dicesim ") + git_describe(), "Print the version and exit (dicesim version: the build)");
+  accept_number_forms(app);
+  if (argc >= 2 && argv[1][0] != '-') {
+    const auto subs = app.get_subcommands({});
+    if (std::none_of(subs.begin(), subs.end(), [&](const CLI::App* s) { return s->check_name(argv[1]); }))
+      return unknown_command(app, argv[1]);
+  }
   return parse_and_run(app, argc, argv, exit_code);
 }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <optional>
+#include <thread>
 #include <csignal>
 #include <cstdio>
 
@@ -15,13 +16,16 @@
 #include "aggregator/session.hpp"
 #include "aggregator/target.hpp"
 #include "apps/commands.hpp"
+#include "apps/fidelity_name.hpp"
 #include "apps/progress.hpp"
 #include "apps/report.hpp"
 #include "logger/log.hpp"
 #include "messages/run_spec.hpp"
+#include "messages/spec_scene.hpp"
 #include "messages/wire.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/models/compile.hpp"
+#include "sim/study/auto_pilot.hpp"
 
 namespace dicesim {
 namespace {
@@ -39,8 +43,9 @@ void AggregateArgs::add_to(CLI::App* cmd) {
   cmd->add_option("--lcm", lcm,
                   "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0, which never leaves this host)")
       ->type_name("URL");
-  tosses_opt = cmd->add_option("-n,--tosses", tosses, "Number of tosses (with --target-halfwidth: the most it may take)")
-                   ->capture_default_str()
+  tosses_opt = cmd->add_option("-n,--tosses", tosses, "Number of tosses (default 100000). With --target-halfwidth: the most it may take when\n"
+                                     "given; without -n, as many as the target needs (up to 10^9).\n"
+                                     "Any exact whole number: 100000, 1e5, 100_000")
                    ->check(CLI::Range(1ULL, 1ULL << 40));
   cmd->add_option("--seed", seed, "Run seed (with the toss index, the only source of randomness)")->capture_default_str();
   cmd->add_option("--trace-every", trace_every,
@@ -88,8 +93,15 @@ PreparedRun prepare_run(const AggregateArgs& a, std::int64_t run_id) {
   // Bad input fails here, before anything is published (SceneError -> exit 2 in run_cli).
   DieModel model = compile(a.scene.load(), a.scene.path);
   std::vector<std::string> overrides = a.scene.overrides;  // as SceneArgs::load composes them
+  check_fidelity_name(a.scene.fidelity);
   if (!a.scene.fidelity.empty()) overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
   const std::uint64_t total = a.target_halfwidth > 0 && a.tosses_opt && a.tosses_opt->count() == 0 ? kTargetCap : a.tosses;
+  // auto: the pilot runs here, once; the workers are told the model it chose (an override), so
+  // every process tosses the same model without a pilot of its own.
+  resolve_auto(model, a.target_halfwidth > 0 ? precision_of_target(model, a.target_halfwidth) : precision_of_run(model, a.tosses),
+               static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  if (model.fidelity_requested == Fidelity::Auto)
+    overrides.push_back(std::string("sim.fidelity=\"") + to_string(model.fidelity) + "\"");
   wire::RunSpec spec = wire::make_run_spec(run_id != 0 ? run_id : wire::new_run_id(), a.scene.path, overrides, model, a.seed,
                                            total, a.trace_every);
   return {std::move(model), std::move(spec)};
@@ -205,7 +217,15 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   r.tosses = res.tosses;
   r.counts = res.counts;
   set_labels(r, model);
+  // auto: the pilot's numbers as `toss` reports them (prepare_run resolved the model; the pilot is a
+  // function of the scene and the run's size, so running it again gives the same numbers).
+  if (!resume && model.fidelity_requested == Fidelity::Auto) {
+    DieModel again = model;
+    r.pilot = resolve_auto(again, a.target_halfwidth > 0 ? precision_of_target(again, a.target_halfwidth) : precision_of_run(again, a.tosses),
+                           static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  }
   r.elapsed_s = res.run_elapsed_s;
+  r.provenance = make_provenance(spec.origin, spec.overrides, wire::spec_scene_sha256(spec), model, spec.seed, spec.total, r.threads);
   print_report(r, a.json);
   return kExitOk;
 }

@@ -6,12 +6,17 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <sstream>
 #include <thread>
 
 #include "apps/commands.hpp"
+#include "apps/fidelity_name.hpp"
 #include "apps/fit_json.hpp"
 #include "apps/gnuplot.hpp"
+#include "apps/interrupt.hpp"
+#include "apps/output_path.hpp"
+#include "sim/scene/key_unit.hpp"
 #include "apps/progress.hpp"
 #include "sim/scene/scene_error.hpp"
 #include "sim/study/fit.hpp"
@@ -33,18 +38,26 @@ struct FitArgs {
   std::string plot;
 };
 
-std::atomic<bool> g_stop{false};
-void on_stop_signal(int) { g_stop = true; }
-
 void write_profile_plot(const std::string& path, const FitResult& r) {
   std::ostringstream gp;
   const int d = static_cast<int>(r.params.size());
   gp << gnuplot_terminal(path, 480 * d + 60, 420);
+  std::string scenes;
+  std::uint64_t observed = 0;
+  for (const FitDataResult& data : r.data) {
+    if (scenes.find(data.scene) == std::string::npos) scenes += (scenes.empty() ? "" : ", ") + data.scene;
+    for (const auto c : data.observed) observed += c;
+  }
   gp << "set multiplot layout 1," << d << " title "
-     << gnuplot_quote("profile likelihood, " + std::to_string(r.simulated_tosses) + " tosses simulated") << " noenhanced\n";
-  gp << "set grid\nset border 3\nset tics nomirror\nset ylabel '2 (l_max - l_profile)' noenhanced\nset key top center\n";
+     << gnuplot_quote("profile likelihood: " + scenes + ", fidelity " + r.fidelity + "\n" + std::to_string(observed) +
+                      " observed tosses, " + std::to_string(r.simulated_tosses) + " simulated")
+     << " noenhanced\n";
+  // The legend below the axes: at the top centre it covered the profile's minimum.
+  gp << "set grid\nset border 3\nset tics nomirror\nset ylabel '2 (l_max - l_profile)' noenhanced\n"
+        "set key below horizontal noenhanced\n";
   for (const FitParamResult& p : r.params) {
-    gp << "set xlabel " << gnuplot_quote(p.key) << " noenhanced\n";
+    const std::string unit = key_unit(p.key);
+    gp << "set xlabel " << gnuplot_quote(unit.empty() ? p.key : p.key + " (" + unit + ")") << " noenhanced\n";
     gp << "set yrange [0:8]\n";
     gp << "set arrow from " << number_text(p.ci95.lo) << ",0 to " << number_text(p.ci95.lo) << ",3.841 nohead dt 2\n";
     gp << "set arrow from " << number_text(p.ci95.hi) << ",0 to " << number_text(p.ci95.hi) << ",3.841 nohead dt 2\n";
@@ -60,10 +73,11 @@ void write_profile_plot(const std::string& path, const FitResult& r) {
   run_gnuplot(gp.str(), path);
 }
 
-void print_text(const FitResult& r, const FitArgs& a) {
+void print_text(const FitResult& r, const FitArgs& a, const FitOptions& opt) {
   std::printf("dicesim fit: %zu parameter%s, %zu data set%s, fidelity %s, seed %llu\n", r.params.size(),
               r.params.size() == 1 ? "" : "s", r.data.size(), r.data.size() == 1 ? "" : "s", r.fidelity.c_str(),
               static_cast<unsigned long long>(a.seed));
+  std::fputs(provenance_lines(fit_provenance(a.scene.path, opt, r.fidelity, r.fidelity_reason)).c_str(), stdout);
   for (const FitDataResult& d : r.data) {
     std::uint64_t n = 0;
     for (const auto c : d.observed) n += c;
@@ -131,25 +145,60 @@ int run_fit_cmd(const FitArgs& a) {
     const std::string ext = fs::path(a.plot).extension().string();
     if (ext != ".png" && ext != ".svg") throw SceneError("dicesim fit", "--plot", a.plot, "must end in .png or .svg");
   }
+  check_output_path("dicesim fit", "--plot", a.plot);  // before any toss
   FitOptions opt;
   opt.overrides = a.scene.overrides;
+  check_fidelity_name(a.scene.fidelity);
   if (!a.scene.fidelity.empty()) opt.overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
   opt.seed = a.seed;
   opt.threads = a.threads;
   opt.tosses = a.tosses;
   opt.rounds = a.rounds;
   ProgressBar bar;
-  opt.progress = [&bar](const std::string&, std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
-  std::signal(SIGINT, on_stop_signal);
-  std::signal(SIGTERM, on_stop_signal);
-  opt.cancel = &g_stop;
-  const FitResult r = run_fit(params, data, opt);
+  // Where the fit was when interrupted: a fit has no estimate before a round's whole grid is tossed.
+  struct State {
+    std::string stage;
+    std::uint64_t done = 0, total = 0;
+  } state;
+  std::mutex state_mu;  // run_fit's threads report at once
+  opt.progress = [&bar, &state, &state_mu](const std::string& stage, std::uint64_t done, std::uint64_t total) {
+    {
+      std::lock_guard lock(state_mu);
+      if (done >= state.done || stage != state.stage) state = {stage, done, total};
+    }
+    bar.update(done, total);
+  };
+  const InterruptGuard interrupt;
+  opt.cancel = InterruptGuard::flag();
+  FitResult r;
+  try {
+    r = run_fit(params, data, opt);
+  } catch (const std::runtime_error&) {
+    bar.finish();
+    if (!InterruptGuard::interrupted()) throw;
+    const Provenance prov = fit_provenance(a.scene.path, opt, "", "");
+    if (a.json) {
+      std::printf("%s\n", nlohmann::json{{"partial", true},
+                                         {"state", {{"stage", state.stage}, {"tosses_done", state.done}, {"tosses_total", state.total}}},
+                                         {"estimate", nullptr},
+                                         {"provenance", provenance_json(prov)}}
+                              .dump()
+                              .c_str());
+    } else {
+      std::printf("dicesim fit: interrupted in %s, after %llu of %llu tosses; no estimate (a round's whole grid is needed)\n",
+                  state.stage.empty() ? "its checks" : state.stage.c_str(), static_cast<unsigned long long>(state.done),
+                  static_cast<unsigned long long>(state.total));
+      std::fputs(provenance_lines(prov).c_str(), stdout);
+    }
+    std::fprintf(stderr, "dicesim fit: interrupted\n");
+    return kExitInterrupted;
+  }
   bar.finish();
   if (!a.plot.empty()) write_profile_plot(a.plot, r);
   if (a.json)
     std::printf("%s\n", fit_json(r, opt).dump().c_str());
   else
-    print_text(r, a);
+    print_text(r, a, opt);
   return kExitOk;
 }
 

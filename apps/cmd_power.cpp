@@ -6,9 +6,12 @@
 #include <thread>
 
 #include "apps/commands.hpp"
+#include "apps/interrupt.hpp"
 #include "apps/power_report.hpp"
 #include "apps/progress.hpp"
 #include "sim/models/compile.hpp"
+#include "sim/scene/scene_hash.hpp"
+#include "sim/study/auto_pilot.hpp"
 #include "sim/scene/scene_error.hpp"
 #include "sim/study/sweep.hpp"
 
@@ -52,12 +55,19 @@ void check(const PowerArgs& a) {
 int run_power(const PowerArgs& a) {
   check(a);
   const auto t0 = std::chrono::steady_clock::now();
-  const DieModel model = compile(a.scene.load(), a.scene.path);
+  const SceneDef def = a.scene.load();
+  DieModel model = compile(def, a.scene.path);
+  // auto: each scene's pilot at the study's simulated tosses.
+  resolve_auto(model, precision_of_run(model, a.tosses), a.threads);
   std::unique_ptr<DieModel> other;
+  std::string against_sha256;
   if (!a.against.empty()) {
     SceneArgs b = a.scene;  // --set and --fidelity apply to both scenes
     b.path = a.against;
-    other = std::make_unique<DieModel>(compile(b.load(), b.path));
+    const SceneDef def_b = b.load();
+    against_sha256 = scene_sha256(b.path, b.applied_overrides());
+    other = std::make_unique<DieModel>(compile(def_b, b.path));
+    resolve_auto(*other, precision_of_run(*other, a.tosses), a.threads);
     if (other->outcome_labels != model.outcome_labels)
       throw SceneError(a.against, "outcome labels", labels_text(other->outcome_labels),
                        "must equal those of " + a.scene.path + " " + labels_text(model.outcome_labels) +
@@ -72,6 +82,8 @@ int run_power(const PowerArgs& a) {
   if (other) info.fidelity_against = to_string(other->fidelity);
   info.seed = a.seed;
   info.threads = a.threads;
+  info.provenance = make_provenance(a.scene.path, a.scene.applied_overrides(), scene_sha256(a.scene.path, a.scene.applied_overrides()), model, a.seed, a.tosses, a.threads);
+  info.against_sha256 = against_sha256;
   PowerStudyConfig& cfg = info.config;
   cfg.tosses = a.tosses;
   cfg.seed = a.seed;
@@ -82,6 +94,24 @@ int run_power(const PowerArgs& a) {
   cfg.target.replicates = a.replicates;
   cfg.target.seed = a.seed;
   cfg.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
+  const InterruptGuard interrupt;  // Ctrl-C / SIGTERM: what is done is printed, exit 130
+  cfg.cancel = InterruptGuard::flag();
+  // An interrupted study has no n: its state (tosses simulated) and that it is partial.
+  auto interrupted = [&](std::uint64_t simulated) {
+    bar.finish();
+    if (a.json)
+      std::printf("%s\n", nlohmann::json{{"partial", true},
+                                         {"state", {{"simulated_tosses", simulated}}},
+                                         {"n_exact", nullptr},
+                                         {"provenance", provenance_json(info.provenance)}}
+                              .dump()
+                              .c_str());
+    else
+      std::printf("dicesim power: interrupted after %llu tosses simulated; no n (the study needs all of them)\n%s",
+                  static_cast<unsigned long long>(simulated), provenance_lines(info.provenance).c_str());
+    std::fprintf(stderr, "dicesim power: interrupted\n");
+    return kExitInterrupted;
+  };
   // The searches for n after the tosses (seconds for a d20's 40 alternatives): a line every 2 s.
   double last_line = 0.0;
   cfg.search_progress = [&](std::size_t done, std::size_t total) {
@@ -96,6 +126,7 @@ int run_power(const PowerArgs& a) {
   nlohmann::json j;
   if (other) {
     const AgainstStudy s = power_against(model, *other, cfg);
+    if (s.cancelled || InterruptGuard::interrupted()) return interrupted(s.simulated_tosses);
     bar.finish();
     info.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (s.difference.p_value >= kPowerDifferenceLevel)
@@ -107,6 +138,7 @@ int run_power(const PowerArgs& a) {
     else text = power_table(info, s);
   } else {
     const BiasStudy s = power_detect_bias(model, a.detect_bias, cfg);
+    if (s.cancelled || InterruptGuard::interrupted()) return interrupted(s.simulated_tosses);
     bar.finish();
     info.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (a.json) j = power_json(info, s);

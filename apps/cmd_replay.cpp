@@ -12,6 +12,7 @@
 #include "aggregator/session.hpp"
 #include "apps/commands.hpp"
 #include "apps/report.hpp"
+#include "messages/spec_scene.hpp"
 #include "logger/event_log.hpp"
 #include "logger/log.hpp"
 #include "logger/replay.hpp"
@@ -87,6 +88,14 @@ int replay_run(const ReplayArgs& a) {
   else
     r.labels.assign(res.labels.begin(), res.labels.end());
   r.elapsed_s = elapsed;
+  // This build's version; the scene as the log's run_start describes it.
+  std::string sha;
+  try {
+    sha = wire::spec_scene_sha256(res.spec);
+  } catch (const std::exception&) {  // a scene this build no longer reads: its hash stays unknown
+  }
+  r.provenance = make_provenance(res.spec.origin, res.spec.overrides, sha, res.model, res.spec.seed, res.spec.total, r.threads);
+  r.provenance.fidelity = res.spec.fidelity;
   print_report(r, a.json);
   return kExitOk;
 }

@@ -16,14 +16,22 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
+#include "apps/fidelity_name.hpp"
 #include "apps/gnuplot.hpp"
+#include "apps/interrupt.hpp"
+#include "apps/output_path.hpp"
+#include "apps/provenance.hpp"
 #include "apps/progress.hpp"
 #include "apps/report.hpp"
 #include "apps/sweep_workers.hpp"
 #include "messages/wire.hpp"
+#include "sim/body/outcome.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/scene/key_unit.hpp"
 #include "sim/study/compare.hpp"
 #include "sim/study/shard.hpp"
 #include "sim/scene/scene_error.hpp"
+#include "sim/scene/scene_hash.hpp"
 #include "sim/study/sweep.hpp"
 
 namespace dicesim {
@@ -51,9 +59,6 @@ struct SweepArgs {
   std::string points;        // --points I/N: shard I of N of the points
   bool distributed() const { return workers > 0 || !lcm.empty(); }
 };
-
-std::atomic<bool> g_stop{false};
-void on_stop_signal(int) { g_stop = true; }
 
 // A point compared with the seed's row at the same x.
 struct SeedMatch {
@@ -88,19 +93,87 @@ std::string fmt(const char* f, double v) {
 
 bool has_categories(const SweepSpec& spec) { return spec.categorical; }
 
-// P(face) against x, one colour per outcome (label order; ten colours, then again with another
-// point type), the 95% Wilson band shaded, the seed's values (if any) as open circles of the same colour.
+// What the plot needs beyond the counts: the x axis's label (with the key's unit), each outcome's
+// name for the legend, and the question's reference probability (0: none).
+struct PlotLabels {
+  std::string x_label;
+  std::vector<std::string> names;  // per outcome, label order
+  double reference = 0.0;
+  std::string reference_text;
+};
+
+// Outcomes alike by design: a regular solid (the d4-d20 presets, or a box of three equal edges) of
+// one material (no regions), each face its own outcome. Only for such a die is 1/N the answer a
+// fair die would give, so only then is it drawn; a coin's reference comes from its sweep file.
+bool alike_by_design(const SceneDef& def, std::size_t outcomes, int faces) {
+  const DieDef& d = def.die;
+  const bool regular = d.shape == ShapeKind::D4 || d.shape == ShapeKind::D6 || d.shape == ShapeKind::D8 ||
+                       d.shape == ShapeKind::D10 || d.shape == ShapeKind::D12 || d.shape == ShapeKind::D20 ||
+                       (d.shape == ShapeKind::Box && d.size.x() == d.size.y() && d.size.y() == d.size.z());
+  return regular && d.regions.empty() && static_cast<int>(outcomes) == faces;
+}
+
+PlotLabels plot_labels(const SweepSpec& spec, const SweepArgs& a, bool file_mode) {
+  PlotLabels pl;
+  pl.x_label = spec.x_label;
+  // A bare key (the CLI's --param) gets its unit from the scene schema; a sweep file's x_label is
+  // its author's (with the unit of its own x, which scale and shift may have changed).
+  if (!file_mode) {
+    const std::string unit = key_unit(a.param);
+    const bool plain = a.scale == 1.0 && a.shift == 0.0;
+    if (!plain)
+      pl.x_label = "x, where " + a.param + " = " + number_text(a.scale) + " x + " + number_text(a.shift) +
+                   (unit.empty() ? "" : " (" + unit + ")");
+    else if (!unit.empty())
+      pl.x_label += " (" + unit + ")";
+  }
+  if (spec.points.empty()) return pl;
+  std::vector<std::string> all = spec.overrides;
+  all.insert(all.end(), spec.points[0].overrides.begin(), spec.points[0].overrides.end());
+  const SceneDef def = load_scene(spec.scene, all);
+  const DieModel m = compile(def, spec.scene);
+  pl.names = outcome_names(m);
+  if (pl.names.empty())
+    for (int l : m.outcome_labels) pl.names.push_back("face " + std::to_string(l));
+  if (spec.reference > 0.0) {
+    pl.reference = spec.reference;
+    pl.reference_text = "reference " + short_text(spec.reference);
+  } else if (alike_by_design(def, m.outcome_labels.size(), m.face_count())) {
+    pl.reference = 1.0 / static_cast<double>(m.outcome_labels.size());
+    pl.reference_text = "1/" + std::to_string(m.outcome_labels.size()) + " (alike by design)";
+  }
+  return pl;
+}
+
+// P(outcome) against x, one colour per outcome (label order; ten colours, then again with another
+// point type), the 95% Wilson band shaded, the seed's values (if any) as open circles of the same
+// colour, the question's reference line, and the share of tosses without an answer (unresolved +
+// invalid, of all tosses) when there are any. y stays within [0, 1]; the legend outside the data.
 void write_plot(const std::string& path, const SweepSpec& spec, const SweepResult& res,
-                const std::vector<ReferenceRow>& seed_rows) {
+                const std::vector<ReferenceRow>& seed_rows, const PlotLabels& pl) {
   std::ostringstream gp;
   gp << gnuplot_terminal(path);
   std::string title = spec.title;
   if (!spec.reproduces.empty()) title += " (seed: " + spec.reproduces + ")";
-  gp << "set title " << gnuplot_quote(title + "\n" + std::to_string(spec.tosses) + " tosses per point, seed " +
-                                     std::to_string(spec.seed) + ", same tosses at every point; bands: 95% Wilson")
+  std::uint64_t lost = 0;
+  for (const SweepPointResult& r : res.points) lost += r.counts.unresolved + r.counts.invalid;
+  const std::string fidelity = res.points.empty() ? "" : res.points[0].fidelity;
+  gp << "set title " << gnuplot_quote(title + "\n" + spec.scene + ", fidelity " + fidelity + ", " +
+                                     std::to_string(spec.tosses) + " tosses per point (seed " + std::to_string(spec.seed) +
+                                     ", the same at every point); bands: 95% Wilson" +
+                                     (lost == 0 ? "; every toss settled" : ""))
      << " noenhanced\n";
-  gp << "set xlabel " << gnuplot_quote(spec.x_label) << " noenhanced\n";
-  gp << "set offsets 0, 0, graph 0.04, graph 0.04\nset ylabel 'P(face up)'\nset grid\nset key outside right top box opaque\nset border 3\nset tics nomirror\n";
+  gp << "set xlabel " << gnuplot_quote(pl.x_label) << " noenhanced\n";
+  double ymax = pl.reference;
+  for (const SweepPointResult& r : res.points) {
+    for (const FaceEstimate& f : face_estimates(r.counts, r.labels)) ymax = std::max(ymax, f.ci95.hi);
+    if (r.counts.total() > 0)
+      ymax = std::max(ymax, static_cast<double>(r.counts.unresolved + r.counts.invalid) / static_cast<double>(r.counts.total()));
+  }
+  ymax = std::min(1.0, 1.08 * ymax + 0.01);
+  gp << "set yrange [0:" << number_text(ymax) << "]\nset offsets 0, 0, 0, 0\n";
+  gp << "set ylabel 'P(outcome), of the settled tosses' noenhanced\nset grid\nset key outside right top box opaque noenhanced\n"
+        "set border 3\nset tics nomirror\n";
   const auto labels = res.points.empty() ? std::vector<FaceEstimate>{} : face_estimates(res.points[0].counts, res.points[0].labels);
   const int n = static_cast<int>(labels.size());
   const char* colours[10] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
@@ -119,12 +192,14 @@ void write_plot(const std::string& path, const SweepSpec& spec, const SweepResul
                                               [](const SweepPoint& a, const SweepPoint& b) { return a.x < b.x; });
     gp << "set xrange [" << number_text(mn->x - 0.5) << ":" << number_text(mx->x + 0.5) << "]\n";
   }
+  // Columns: x, then p lo hi per outcome, then the share without an answer.
   gp << "$d << EOD\n";
   for (const SweepPointResult& r : res.points) {
     gp << number_text(r.point.x);
     for (const FaceEstimate& f : face_estimates(r.counts, r.labels))
       gp << " " << number_text(f.p) << " " << number_text(f.ci95.lo) << " " << number_text(f.ci95.hi);
-    gp << "\n";
+    const double total = static_cast<double>(std::max<std::uint64_t>(1, r.counts.total()));
+    gp << " " << number_text(static_cast<double>(r.counts.unresolved + r.counts.invalid) / total) << "\n";
   }
   gp << "EOD\n";
   bool any_seed = false;
@@ -141,19 +216,28 @@ void write_plot(const std::string& path, const SweepSpec& spec, const SweepResul
   for (int f = 1; f <= n; ++f)
     gp << "$d using 1:" << 3 * f << ":" << 3 * f + 1 << " with filledcurves lt " << f
        << " fs transparent solid 0.18 noborder notitle, ";
-  for (int f = 1; f <= n; ++f)
-    gp << "$d using 1:" << 3 * f - 1 << " with linespoints lt " << f << " title 'face "
-       << labels[static_cast<std::size_t>(f - 1)].label << "'" << (f < n || any_seed ? ", " : "\n");
-  if (any_seed) {
-    for (int f = 1; f <= 6; ++f) gp << "$s using 1:" << f + 1 << " with points lt " << f << " pt 6 ps 1.1 notitle, ";
-    gp << "NaN with points pt 6 ps 1.1 lc rgb 'black' title 'seed'\n";
+  for (int f = 1; f <= n; ++f) {
+    const std::size_t i = static_cast<std::size_t>(f - 1);
+    gp << "$d using 1:" << 3 * f - 1 << " with linespoints lt " << f << " title "
+       << gnuplot_quote(i < pl.names.size() ? pl.names[i] : "face " + std::to_string(labels[i].label));
+    if (f < n) gp << ", ";
   }
-
+  if (pl.reference > 0.0)
+    gp << ", " << number_text(pl.reference) << " with lines dt 2 lw 1.5 lc rgb 'black' title " << gnuplot_quote(pl.reference_text);
+  if (lost > 0)
+    gp << ", $d using 1:" << 3 * n + 2 << " with linespoints dt 3 lw 1.5 pt 2 ps 0.6 lc rgb '#555555' title "
+       << gnuplot_quote("unresolved + invalid (of all tosses)");
+  if (any_seed) {
+    gp << ", ";
+    for (int f = 1; f <= 6; ++f) gp << "$s using 1:" << f + 1 << " with points lt " << f << " pt 6 ps 1.1 notitle, ";
+    gp << "NaN with points pt 6 ps 1.1 lc rgb 'black' title 'seed'";
+  }
+  gp << "\n";
   run_gnuplot(gp.str(), path);
 }
 
-std::string csv_text(const SweepResult& res) {
-  std::string out = "param,face,count,p,lo,hi\n";
+std::string csv_text(const SweepResult& res, const Provenance& prov) {
+  std::string out = provenance_csv_comment(prov) + "param,face,count,p,lo,hi\n";
   for (const SweepPointResult& r : res.points)
     for (const FaceEstimate& f : face_estimates(r.counts, r.labels))
       out += number_text(r.point.x) + "," + std::to_string(f.label) + "," + std::to_string(f.count) + "," +
@@ -161,8 +245,29 @@ std::string csv_text(const SweepResult& res) {
   return out;
 }
 
+// The sweep's provenance: the base scene (every point's overrides but the swept key's) and its hash;
+// the fidelity and why of the first point (each point also carries its own scene hash).
+Provenance sweep_provenance(const SweepSpec& spec, const SweepResult& res, int threads) {
+  Provenance p;
+  p.scene = spec.scene;
+  p.scene_sha256 = scene_sha256(spec.scene, spec.overrides);
+  p.overrides = spec.overrides;
+  if (!res.points.empty()) {
+    p.fidelity = res.points[0].fidelity;
+    p.fidelity_reason = res.points[0].fidelity_reason;
+  }
+  p.seed = spec.seed;
+  p.tosses = spec.tosses;
+  p.threads = threads;
+  return p;
+}
+
+bool sweep_partial(const SweepSpec& spec, const SweepResult& res) {
+  return res.points.size() < spec.points.size() || (!res.points.empty() && res.points.back().partial);
+}
+
 nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const std::vector<ReferenceRow>& seed_rows,
-                           int threads, int workers) {
+                           int threads, int workers, const Provenance& prov) {
   nlohmann::json points = nlohmann::json::array();
   int compared = 0, rejected = 0;
   std::uint64_t tosses = 0;
@@ -177,7 +282,15 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
                         {"unresolved", r.counts.unresolved},
                         {"invalid", r.counts.invalid},
                         {"corrections", corrections_json(r.counts.corrections)},
-                        {"faces", faces}};
+                        {"fidelity", r.fidelity},  // auto: each point's own pilot (its reason and numbers)
+                        {"fidelity_reason", r.fidelity_reason},
+                        {"pilot", pilot_json(r.pilot)},
+                        {"faces", faces},
+                        {"scene_sha256", r.scene_sha256}};
+    if (r.partial) {
+      p["partial"] = true;
+      p["tosses"] = r.counts.total();
+    }
     const SeedMatch m = match_seed(spec, seed_rows, r);
     if (m.found) {
       p["seed"] = {{"p", m.p}};
@@ -201,8 +314,11 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
                       {"threads", threads},
                       {"workers", workers},
                       {"points", points},
+                      {"partial", sweep_partial(spec, res)},
+                      {"points_requested", spec.points.size()},
                       {"elapsed_s", res.elapsed_s},
                       {"tosses_per_s", res.elapsed_s > 0 ? static_cast<double>(tosses) / res.elapsed_s : 0.0}};
+  j["provenance"] = provenance_json(prov);
   if (!spec.seed_table.empty())
     j["seed_comparison"] = {{"table", spec.seed_table},
                             {"reproduces", spec.reproduces},
@@ -212,12 +328,28 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
   return j;
 }
 
-std::string table_text(const SweepSpec& spec, const SweepResult& res, int threads, int workers) {
+std::string table_text(const SweepSpec& spec, const SweepResult& res, int threads, int workers, const Provenance& prov) {
   std::ostringstream out;
   out << spec.title << "  (" << spec.scene << ", fidelity " << (res.points.empty() ? "" : res.points[0].fidelity)
       << ", seed " << spec.seed << ", " << spec.tosses << " tosses per point, ";
-  if (workers > 0) out << workers << " worker process" << (workers == 1 ? "" : "es") << ")\n\n";
-  else out << threads << " thread" << (threads == 1 ? "" : "s") << ")\n\n";
+  if (workers > 0) out << workers << " worker process" << (workers == 1 ? "" : "es") << ")\n";
+  else out << threads << " thread" << (threads == 1 ? "" : "s") << ")\n";
+  out << provenance_lines(prov);
+  if (sweep_partial(spec, res)) {
+    std::size_t whole = res.points.size();
+    if (whole > 0 && res.points.back().partial) --whole;
+    out << "interrupted after " << whole << " of " << spec.points.size() << " points";
+    if (whole < res.points.size())
+      out << " (point " << res.points.back().point.label << ": the first " << res.points.back().counts.total() << " of "
+          << spec.tosses << " tosses)";
+    }
+  if (!res.points.empty() && res.points[0].fidelity_reason.rfind("auto", 0) == 0) {
+    // auto: each point's pilot chose its model (--json: each point's reason and pilot).
+    out << "auto, each point's pilot at " << spec.tosses << " tosses:";
+    for (const SweepPointResult& r : res.points) out << " " << r.point.label << " " << r.fidelity << ";";
+    out << "\n";
+  }
+  out << "\n";
   const auto first = res.points.empty() ? std::vector<FaceEstimate>{} : face_estimates(res.points[0].counts, res.points[0].labels);
   char line[512];
   std::snprintf(line, sizeof line, "%-14s", spec.x_label.size() <= 14 ? spec.x_label.c_str() : "x");
@@ -313,6 +445,7 @@ std::string markdown_text(const SweepSpec& spec, const SweepResult& res, const s
 
 int run_sweep_cmd(SweepArgs a) {
   if (!fs::is_regular_file(a.input)) throw SceneError(a.input, "", "", "cannot open file");
+  check_fidelity_name(a.fidelity);
   if (!a.fidelity.empty()) a.overrides.push_back("sim.fidelity=\"" + a.fidelity + "\"");
   if (a.json && a.csv == "-") throw SceneError("dicesim sweep", "--csv", "-", "stdout carries the --json object; write the CSV to a file");
   const bool file_mode = is_sweep_file(a.input);
@@ -355,41 +488,46 @@ int run_sweep_cmd(SweepArgs a) {
     const std::string ext = fs::path(a.plot).extension().string();
     if (ext != ".png" && ext != ".svg") throw SceneError("dicesim sweep", "--plot", a.plot, "must end in .png or .svg");
   }
+  // Before any toss: a sweep must not run every point and then fail to write.
+  check_output_path("dicesim sweep", "--csv", a.csv);
+  check_output_path("dicesim sweep", "--plot", a.plot);
+  check_output_path("dicesim sweep", "--markdown", a.markdown);
   const std::vector<ReferenceRow> seed_rows = spec.seed_table.empty() ? std::vector<ReferenceRow>{}
                                                                        : load_reference_table(spec.seed_table);
 
+  const InterruptGuard interrupt;  // Ctrl-C / SIGTERM: the points done are printed, exit 130
   ProgressBar bar;
   SweepRunOptions opt;
   opt.threads = a.threads;
+  opt.cancel = InterruptGuard::flag();
   opt.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
   std::unique_ptr<SweepOverLcm> lcm;
   if (a.distributed()) {
     std::string url = wire::resolve_url(a.lcm);
     if (a.lcm.empty() && url == wire::kDefaultUrl) url = private_lcm_url();
-    std::signal(SIGINT, on_stop_signal);
-    std::signal(SIGTERM, on_stop_signal);
-    lcm = std::make_unique<SweepOverLcm>(spec.scene, url, a.workers, &g_stop);
+    lcm = std::make_unique<SweepOverLcm>(spec.scene, url, a.workers, InterruptGuard::flag());
     opt.run_point = lcm->runner();
-    opt.cancel = &g_stop;
   }
   const SweepResult res = run_sweep(spec, opt);
   bar.finish();
   lcm.reset();  // stops the local workers
-  if (g_stop) {
-    std::fprintf(stderr, "dicesim: interrupted\n");
-    return kExitFailed;
-  }
+  const bool interrupted = InterruptGuard::interrupted();
+  const Provenance prov = sweep_provenance(spec, res, a.threads);
 
   if (!a.csv.empty()) {
-    if (a.csv == "-") std::fputs(csv_text(res).c_str(), stdout);
-    else write_text(a.csv, csv_text(res));
+    if (a.csv == "-") std::fputs(csv_text(res, prov).c_str(), stdout);
+    else write_text(a.csv, csv_text(res, prov));
   }
   if (!a.markdown.empty()) write_text(a.markdown, markdown_text(spec, res, seed_rows));
-  if (!a.plot.empty()) write_plot(a.plot, spec, res, seed_rows);
+  if (!a.plot.empty()) write_plot(a.plot, spec, res, seed_rows, plot_labels(spec, a, file_mode));
   if (a.json)
-    std::printf("%s\n", json_report(spec, res, seed_rows, a.threads, a.workers).dump().c_str());
+    std::printf("%s\n", json_report(spec, res, seed_rows, a.threads, a.workers, prov).dump().c_str());
   else if (a.csv != "-")
-    std::fputs(table_text(spec, res, a.threads, a.workers).c_str(), stdout);
+    std::fputs(table_text(spec, res, a.threads, a.workers, prov).c_str(), stdout);
+  if (interrupted) {
+    std::fprintf(stderr, "dicesim: interrupted after %zu of %zu points\n", res.points.size(), spec.points.size());
+    return kExitInterrupted;
+  }
   return kExitOk;
 }
 

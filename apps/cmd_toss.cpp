@@ -6,11 +6,14 @@
 
 #include "aggregator/target.hpp"
 #include "apps/commands.hpp"
+#include "apps/interrupt.hpp"
 #include "apps/progress.hpp"
 #include "apps/report.hpp"
 #include "apps/shard_file.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/models/compile.hpp"
+#include "sim/scene/scene_hash.hpp"
+#include "sim/study/auto_pilot.hpp"
 #include "sim/study/monte_carlo.hpp"
 
 namespace dicesim {
@@ -30,7 +33,11 @@ struct TossArgs {
 
 int run_toss(const TossArgs& a) {
   const SceneDef def = a.scene.load();
-  const DieModel model = compile(def, a.scene.path);
+  DieModel model = compile(def, a.scene.path);
+  // auto: the pilot judges the cheaper models at this run's precision (its N, or the target).
+  const FidelityPilot pilot = resolve_auto(model,
+               a.target_halfwidth > 0.0 ? precision_of_target(model, a.target_halfwidth) : precision_of_run(model, a.tosses),
+               a.threads);
   Shard shard;
   if (!a.shard.empty()) {
     try {
@@ -58,8 +65,10 @@ int run_toss(const TossArgs& a) {
   if (!a.scene.fidelity.empty()) overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
   const ShardHeader header = a.out.empty() ? ShardHeader{} : make_shard_header(a.scene.path, overrides, model, a.tosses, shard);
 
+  const InterruptGuard interrupt;
   ProgressBar bar;
   RunConfig cfg;
+  cfg.cancel = InterruptGuard::flag();
   cfg.seed = a.seed;
   cfg.first = block.first;
   cfg.tosses = block.tosses;
@@ -79,7 +88,14 @@ int run_toss(const TossArgs& a) {
                  agg::halfwidth_reached(counts, a.target_halfwidth) ? "reached" : "NOT reached",
                  static_cast<unsigned long long>(tosses), agg::max_halfwidth(counts));
 
+  // Interrupted before the end: the counts are the longest complete prefix (monte_carlo.hpp). A
+  // signal after the last toss, or once the target was reached, leaves the answer whole.
+  const bool partial = InterruptGuard::interrupted() && counts.total() < (target ? cap : block.tosses) &&
+                       !(target && agg::halfwidth_reached(counts, a.target_halfwidth));
+  if (partial) tosses = counts.total();
   RunReport r;
+  r.provenance = make_provenance(a.scene.path, a.scene.applied_overrides(), scene_sha256(a.scene.path, a.scene.applied_overrides()), model, a.seed, target ? cap : a.tosses, a.threads);
+  r.partial = partial;
   r.scene = a.scene.path;
   r.fidelity = to_string(model.fidelity);
   r.seed = a.seed;
@@ -87,8 +103,9 @@ int run_toss(const TossArgs& a) {
   r.tosses = tosses;
   r.counts = counts;
   set_labels(r, model);
+  r.pilot = pilot;
   r.elapsed_s = elapsed;
-  if (!a.out.empty()) {
+  if (!a.out.empty() && !partial) {  // an interrupted shard is no shard: nothing for merge
     out_file << shard_json(r, header).dump() << '\n';
     if (!out_file.flush()) {
       std::fprintf(stderr, "dicesim: failed: cannot write --out %s\n", a.out.c_str());
@@ -96,7 +113,9 @@ int run_toss(const TossArgs& a) {
     }
   }
   print_report(r, a.json);
-  return kExitOk;
+  if (partial) std::fprintf(stderr, "dicesim: interrupted after %llu of %llu tosses\n", static_cast<unsigned long long>(tosses),
+                            static_cast<unsigned long long>(r.provenance.tosses));
+  return partial ? kExitInterrupted : kExitOk;
 }
 
 }  // namespace
@@ -107,16 +126,27 @@ void register_toss(CLI::App& app, int& exit_code) {
       "toss",
       "Toss the die N times and print each face's probability with a 95% Wilson interval.\n"
       "Toss i draws its throw from (seed, i) only: the same scene, fidelity, seed and N give\n"
-      "identical counts on any number of threads.\n\n"
+      "identical counts on any number of threads. Ctrl-C (or SIGTERM) prints the tosses done so far,\n"
+      "the longest complete prefix 0..N-1 of the indices (the counts of `-n N`), marked partial; exit 130.\n\n"
       "Examples:\n"
       "  dicesim toss scenes/paper/die1.toml\n"
       "  dicesim toss scenes/paper/die1.toml --tosses 1000000 --threads 2 --json\n"
       "  dicesim toss scenes/fair.toml --set throw.height.mean=0.5 --set sim.stop_speed=0.01\n"
       "  dicesim toss scenes/paper/die3.toml --target-halfwidth 0.002   # as many tosses as that takes\n"
       "  dicesim toss scenes/paper/die1.toml -n 1000000 --shard 3/16 --out part-3.json   # then: dicesim merge part-*.json");
+  cmd->footer(
+      "\nWhich fidelity (--fidelity; scenes/README.md, docs/fidelity.md):\n"
+      "  auto     the cheapest model measured adequate for this scene at this run's precision, else\n"
+      "           impulse (`dicesim info SCENE` says which and why)\n"
+      "  impulse  a real, unfair die or coin: friction, rolling, tipping to rest; its accuracy knob is\n"
+      "           sim.contact_step (default 3 ms for polyhedra, 1 ms for cylinders)\n"
+      "  stepped  the reference (fixed 0.2 ms steps), over 10x slower than impulse: to check a new die\n"
+      "  paper    only to reproduce the seed's tables (frictionless corners, a rebound-speed stop)\n"
+      "  static   a die placed, not thrown (random orientation, quasi-static roll); instant");
   args->scene.add_to(cmd);
-  args->tosses_opt = cmd->add_option("-n,--tosses", args->tosses, "Number of tosses (with --target-halfwidth: the most it may take)")
-                         ->capture_default_str()
+  args->tosses_opt = cmd->add_option("-n,--tosses", args->tosses, "Number of tosses (default 100000). With --target-halfwidth: the most it may take when\n"
+                                     "given; without -n, as many as the target needs (up to 10^9).\n"
+                                     "Any exact whole number: 100000, 1e5, 100_000")
                          ->check(CLI::Range(1ULL, 1ULL << 40));
   cmd->add_option("--seed", args->seed, "Run seed (with the toss index, the only source of randomness)")
       ->capture_default_str();

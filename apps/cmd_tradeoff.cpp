@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
+#include "apps/number_forms.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/study/agreement.hpp"
 #include "sim/body/die_model.hpp"
@@ -233,6 +234,7 @@ int run_bench_tradeoff(int argc, char** argv) {
   app.add_option("--plot", a->plot, "Also draw accuracy against speed as PNG (gnuplot)")->type_name("FILE.png");
   int exit_code = kExitOk;
   app.callback([a, &exit_code] { exit_code = run_tradeoff(*a); });
+  accept_number_forms(app);
   return parse_and_run(app, argc, argv, exit_code);
 }
 

@@ -80,6 +80,9 @@ int watch(const WatchArgs& a) {
   bus.subscribe(wire::kProbabilities, &Printer::handle, &printer);
   std::signal(SIGINT, on_stop_signal);
   std::signal(SIGTERM, on_stop_signal);
+  // Nothing may be heard for a while (no run yet): say where we listen, on stderr (stdout is the answers).
+  std::fprintf(stderr, "dicesim: watching %s on %s for %s; Ctrl-C to stop\n", wire::kProbabilities, url.c_str(),
+               a.run != 0 ? ("run " + std::to_string(a.run)).c_str() : "any run");
   const auto t0 = std::chrono::steady_clock::now();
   while (!g_stop && !(a.until_finished && printer.finished)) {
     bus.handleTimeout(100);

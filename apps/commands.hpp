@@ -25,6 +25,8 @@ struct SceneArgs {
   std::string fidelity;
   void add_to(CLI::App* cmd);
   SceneDef load() const;  // throws SceneError
+  // The overrides load() applies, in order: every --set, then --fidelity as sim.fidelity="F" (provenance).
+  std::vector<std::string> applied_overrides() const;
 };
 
 // --key-file FILE (authenticated runs, messages/auth.hpp), with the same help on every command.
@@ -51,6 +53,7 @@ void register_record(CLI::App& app, int& exit_code);  // cmd_record.cpp
 void register_replay(CLI::App& app, int& exit_code);  // cmd_replay.cpp
 void register_merge(CLI::App& app, int& exit_code);   // cmd_merge.cpp: shards of `toss --shard`
 void register_hub(CLI::App& app, int& exit_code);     // cmd_hub.cpp: LCM's TCP hub
+void register_version(CLI::App& app, int& exit_code); // cmd_version.cpp
 
 // Distributed runs (cmd_aggregate.cpp): what `aggregate` and `run` share.
 struct AggregateArgs {

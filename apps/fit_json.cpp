@@ -1,8 +1,26 @@
 #include "apps/fit_json.hpp"
 
 #include "apps/report.hpp"
+#include "sim/scene/scene_hash.hpp"
 
 namespace dicesim {
+
+Provenance fit_provenance(const std::string& scene, const FitOptions& opt, const std::string& fidelity,
+                          const std::string& fidelity_reason) {
+  Provenance p;
+  p.scene = scene;
+  try {
+    p.scene_sha256 = scene_sha256(scene, opt.overrides);
+  } catch (const std::exception&) {  // not a file (a scene given as text): its hash is unknown
+  }
+  p.overrides = opt.overrides;
+  p.fidelity = fidelity;
+  p.fidelity_reason = fidelity_reason;
+  p.seed = opt.seed;
+  p.tosses = opt.tosses;
+  p.threads = opt.threads;
+  return p;
+}
 
 nlohmann::json fit_json(const FitResult& r, const FitOptions& opt) {
   nlohmann::json params = nlohmann::json::array();
@@ -36,10 +54,14 @@ nlohmann::json fit_json(const FitResult& r, const FitOptions& opt) {
           {"data", data},
           {"loglik", json_number(r.loglik)},
           {"fidelity", r.fidelity},
+          {"fidelity_reason", r.fidelity_reason},
           {"seed", opt.seed},
           {"rounds", rounds},
           {"simulated_tosses", r.simulated_tosses},
-          {"elapsed_s", r.elapsed_s}};
+          {"elapsed_s", r.elapsed_s},
+          {"partial", false},
+          {"provenance", provenance_json(fit_provenance(r.data.empty() ? "" : r.data.front().scene, opt, r.fidelity,
+                                                         r.fidelity_reason))}};
 }
 
 }  // namespace dicesim

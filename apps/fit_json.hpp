@@ -3,12 +3,17 @@
 
 #include <nlohmann/json.hpp>
 
+#include "apps/provenance.hpp"
 #include "sim/study/fit.hpp"
 
 namespace dicesim {
 
 // {"params": [{"key", "estimate", "ci95": [lo, hi], ...}], "fitted": [{"label", "p", ...}],
 //  "gof": {"statistic", "dof", "p_value"}, "simulated_tosses", "elapsed_s", ...}. NaN -> null.
+// "provenance" (apps/provenance.hpp): the first data set's scene with opt.overrides (not the fitted
+// keys), "tosses" the last round's per grid point (opt.tosses; 0: automatic).
 nlohmann::json fit_json(const FitResult& r, const FitOptions& opt);
+Provenance fit_provenance(const std::string& scene, const FitOptions& opt, const std::string& fidelity,
+                          const std::string& fidelity_reason);
 
 }  // namespace dicesim

@@ -45,6 +45,8 @@ void run_gnuplot(const std::string& script_text, const std::string& path) {
   const fs::path script = fs::temp_directory_path() / ("dicesim-plot-" + std::to_string(::getpid()) + ".gp");
   const fs::path err = fs::temp_directory_path() / ("dicesim-plot-" + std::to_string(::getpid()) + ".err");
   write_text(script.string(), script_text);
+  // Tests read what was drawn (labels, ranges, lines) from the script, not from the picture.
+  if (const char* keep = std::getenv("DICESIM_PLOT_SCRIPT"); keep && *keep) write_text(keep, script_text);
   const std::string cmd = "gnuplot " + script.string() + " 2>" + err.string();
   const int rc = std::system(cmd.c_str());
   std::string err_text;

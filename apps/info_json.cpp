@@ -24,6 +24,14 @@ nlohmann::json rest_json(const DieModel& m) {
   return faces;
 }
 
+// What the die is made of: the base material's part, then each region (m^3, kg).
+nlohmann::json parts_json(const std::vector<MaterialPart>& given) {
+  nlohmann::json parts = nlohmann::json::array();
+  for (const MaterialPart& p : given)
+    parts.push_back({{"part", p.what}, {"material", p.material}, {"density", p.density}, {"volume", p.volume}, {"mass", p.mass}});
+  return parts;
+}
+
 Vec3 geometric_normal(const DieModel& m, std::size_t f) { return m.geo_to_body.transpose() * m.face_normals[f]; }
 
 // A cylinder's own description (its "corners" are moving rim points, so that list is empty): outer
@@ -62,8 +70,10 @@ nlohmann::json cylinder_json(const DieModel& m) {
 
 }  // namespace
 
-nlohmann::json info_json(const std::string& path, const DieModel& m) {
+nlohmann::json info_json(const std::string& path, const DieModel& m, const std::vector<MaterialPart>& parts) {
   const MassProperties& mp = m.mass_geometric;
+  double volume = 0.0;
+  for (const MaterialPart& p : parts) volume += p.volume;
   const std::vector<double> p_static = static_face_probabilities(m, kInfoStaticDirections);
   nlohmann::json faces = nlohmann::json::array();
   for (std::size_t f = 0; f < m.face_normals.size(); ++f) {
@@ -76,7 +86,8 @@ nlohmann::json info_json(const std::string& path, const DieModel& m) {
     if (m.kind == "box") face["direction"] = kFaceDirNames[f];
     if (m.curved() && f < kCylinderOutcomeNames.size()) {
       face["direction"] = kCylinderOutcomeNames[f];  // heads (+z), tails (-z), edge: the curved side
-      face["curved"] = f == 2;                        // the side has no single normal (printed as 0)
+      face["curved"] = f == 2;                        // the side has no single normal nor flat area:
+      if (f == 2) face["normal"] = nullptr, face["area"] = nullptr;  // null, not a made-up (0, 0, 0)
     }
     faces.push_back(face);
   }
@@ -95,6 +106,8 @@ nlohmann::json info_json(const std::string& path, const DieModel& m) {
           {"face_count", m.face_count()},
           {"outcomes", m.outcome_labels},
           {"mass", mp.mass},
+          {"volume", volume},
+          {"parts", parts_json(parts)},
           {"com", vec(mp.com)},
           {"inertia", mat(mp.inertia)},
           {"principal_moments", vec(mp.principal_moments)},

@@ -49,7 +49,10 @@ json common(const PowerRunInfo& info, const std::vector<int>& labels, const Simu
           {"n_range95_approx", {opt(est.n_range95_approx[0]), opt(est.n_range95_approx[1])}},
           {"n_exact_replicate_sd", est.replicate_sd},
           {"exact", exact_json(est.exact)},
-          {"elapsed_s", info.elapsed_s}};
+          {"elapsed_s", info.elapsed_s},
+          {"partial", false},
+          {"against_sha256", info.against_sha256.empty() ? json(nullptr) : json(info.against_sha256)},
+          {"provenance", provenance_json(info.provenance)}};
 }
 
 std::string format(const char* f, ...) {
@@ -135,6 +138,8 @@ json power_json(const PowerRunInfo& info, const BiasStudy& s) {
 std::string power_table(const PowerRunInfo& info, const AgainstStudy& s) {
   std::string t = format("H0:     %s  (fidelity %s)\nthrown: %s  (fidelity %s)\n", info.scene.c_str(), info.fidelity.c_str(),
                          info.against.c_str(), info.fidelity_against.c_str());
+  t += provenance_lines(info.provenance);
+  if (!info.against_sha256.empty()) t += "thrown scene sha256 " + info.against_sha256 + "\n";
   t += head(info);
   t += "\nface    p H0     95% interval          p thrown  95% interval         difference\n";
   for (std::size_t k = 0; k < s.labels.size(); ++k)
@@ -152,6 +157,7 @@ std::string power_table(const PowerRunInfo& info, const AgainstStudy& s) {
 
 std::string power_table(const PowerRunInfo& info, const BiasStudy& s) {
   std::string t = format("H0:     %s  (fidelity %s)\n", info.scene.c_str(), info.fidelity.c_str());
+  t += provenance_lines(info.provenance);
   t += head(info);
   t += format("alternatives: one face moved by +/-%g, the others rescaled in proportion\n", s.delta);
   t += "\nface    p H0     95% interval        sign   p face   n approx    n exact  power at n\n";

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "apps/provenance.hpp"
 #include "sim/study/power.hpp"
 
 namespace dicesim {
@@ -20,6 +21,8 @@ struct PowerRunInfo {
   int threads = 1;
   PowerStudyConfig config;      // tosses, batches, bootstrap, alpha, power, replicates
   double elapsed_s = 0.0;
+  Provenance provenance;        // of the scene (H0); "tosses" per scene
+  std::string against_sha256;   // the other scene's resolved hash (--against), else empty
 };
 
 // Level at which the simulated difference of two scenes is called significant (below it, n is
@@ -33,6 +36,8 @@ inline constexpr double kPowerDifferenceLevel = 0.05;
 //  "settled_a", "p_a", "p_a_ci95": [[lo, hi]...], and with --against "settled_b", "p_b", "p_b_ci95",
 //  "w2" (sum (p_b - p_a)^2 / p_a; null if infinite), "difference": {"statistic", "dof", "p_value",
 //  "significant"};
+//  "provenance" (apps/provenance.hpp), "against_sha256" (or null), "partial": false (an interrupted
+//  `dicesim power` prints {"partial": true, "state", "provenance"} instead: cmd_power.cpp),
 //  "n_approx", "n_exact", "n_range95": [lo, hi] (n_exact scaled by the bootstrap quantiles of the
 //  approximate n), "n_range95_approx" (those quantiles), "n_exact_replicate_sd" (null n: not
 //  reached by 2^40 throws),

@@ -91,9 +91,14 @@ nlohmann::json report_json(const RunReport& r) {
   const auto coin = chi2_heads_tails(r);
   return {{"scene", r.scene},
           {"fidelity", r.fidelity},
+          {"fidelity_requested", r.fidelity_requested},
+          {"fidelity_reason", r.fidelity_reason},
+          {"pilot", pilot_json(r.pilot)},
           {"seed", r.seed},
           {"threads", r.threads},
           {"tosses", r.tosses},
+          {"partial", r.partial},
+          {"tosses_requested", r.partial ? r.provenance.tosses : r.tosses},
           {"settled", r.counts.settled},
           {"unresolved", r.counts.unresolved},
           {"invalid", r.counts.invalid},
@@ -103,16 +108,27 @@ nlohmann::json report_json(const RunReport& r) {
           {"bounces_per_toss", r.tosses ? static_cast<double>(r.counts.bounces) / static_cast<double>(r.tosses) : 0.0},
           {"corrections", corrections_json(r.counts.corrections)},
           {"elapsed_s", r.elapsed_s},
-          {"tosses_per_s", rate(r)}};
+          {"tosses_per_s", rate(r)},
+          {"provenance", provenance_json(r.provenance)}};
 }
 
 std::string report_table(const RunReport& r) {
   std::string out;
   char line[320];
-  std::snprintf(line, sizeof line, "%s  (fidelity %s, seed %llu, %llu tosses, %d thread%s)\n\n", r.scene.c_str(),
+  std::snprintf(line, sizeof line, "%s  (fidelity %s, seed %llu, %llu tosses, %d thread%s)\n", r.scene.c_str(),
                 r.fidelity.c_str(), static_cast<unsigned long long>(r.seed), static_cast<unsigned long long>(r.tosses),
                 r.threads, r.threads == 1 ? "" : "s");
   out += line;
+  out += provenance_lines(r.provenance);
+  if (r.partial) {
+    std::snprintf(line, sizeof line, "interrupted after %llu of %llu tosses (a complete prefix: the same counts as -n %llu)\n",
+                  static_cast<unsigned long long>(r.tosses), static_cast<unsigned long long>(r.provenance.tosses),
+                  static_cast<unsigned long long>(r.tosses));
+    out += line;
+  }
+  if (r.fidelity_requested == "auto" && r.pilot.ran)  // how auto chose (the reason is in the provenance lines)
+    out += pilot_line(r.pilot, r.fidelity);
+  out += "\n";
   out += "face       count        p     95% interval (Wilson)\n";
   for (const FaceRow& f : face_rows(r)) {
     std::snprintf(line, sizeof line, "%4d  %10llu   %.5f   [%.5f, %.5f]%s%s\n", f.label,
@@ -137,7 +153,43 @@ std::string report_table(const RunReport& r) {
   return out;
 }
 
+nlohmann::json pilot_json(const FidelityPilot& p) {
+  if (!p.ran) return nullptr;
+  nlohmann::json c = nlohmann::json::array();
+  for (const PilotCandidate& k : p.candidates)
+    c.push_back({{"model", to_string(k.model)}, {"pairs", k.pairs}, {"differing", k.differing}, {"bound", k.bound},
+                 {"adequate", k.adequate}});
+  return {{"seed", p.seed},           {"halfwidth", p.halfwidth}, {"precision", p.precision}, {"fraction", p.fraction},
+          {"threshold", p.threshold}, {"max_pairs", p.max_pairs}, {"cap", p.cap},             {"tosses", p.tosses},
+          {"seconds", p.seconds},     {"candidates", c}};
+}
+
+namespace {
+std::string format_seconds(double s) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g s", s);
+  return b;
+}
+}  // namespace
+
+std::string pilot_line(const FidelityPilot& p, const std::string& chosen) {
+  if (!p.ran) return {};
+  std::string out = "auto chose " + chosen + ": pilot of " + std::to_string(p.tosses) + " tosses (" +
+                    format_seconds(p.seconds) + ")";
+  char b[200];
+  for (const PilotCandidate& k : p.candidates) {
+    std::snprintf(b, sizeof b, "; %s differed from impulse in %llu of %llu pairs, bias <= %.3g%s", to_string(k.model),
+                  static_cast<unsigned long long>(k.differing), static_cast<unsigned long long>(k.pairs), k.bound,
+                  k.adequate ? " (adequate)" : "");
+    out += b;
+  }
+  std::snprintf(b, sizeof b, "; adequate: bias < %.3g, half the half-width %.3g\n", p.threshold, p.halfwidth);
+  return out + b;
+}
+
 void set_labels(RunReport& r, const DieModel& m) {
+  r.fidelity_requested = to_string(m.fidelity_requested);
+  r.fidelity_reason = m.fidelity_reason;
   r.labels = m.outcome_labels;
   r.faces_per_label.assign(m.outcome_labels.size(), 0);
   for (const int k : m.face_outcome) ++r.faces_per_label[static_cast<std::size_t>(k)];

@@ -7,7 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "apps/provenance.hpp"
 #include "sim/body/die_model.hpp"
+#include "sim/study/auto_pilot.hpp"
 #include "sim/study/monte_carlo.hpp"
 #include "sim/study/statistics.hpp"
 
@@ -26,6 +28,15 @@ struct RunReport {
   // when labels group them). Empty for a die.
   std::vector<std::string> names;
   double elapsed_s = 0.0;
+  Provenance provenance;  // what made it ("provenance" in JSON, the header's lines in the table)
+  // Interrupted (SIGINT/SIGTERM): `tosses` is the longest complete prefix 0..tosses-1 of the
+  // `provenance.tosses` asked for, so the partial counts equal a fresh run of `tosses` tosses.
+  bool partial = false;
+  // How the fidelity was chosen: stated or auto and why (set_labels copies them from the model),
+  // and auto's pilot (the caller sets it from resolve_auto: sim/study/auto_pilot.hpp).
+  std::string fidelity_requested;
+  std::string fidelity_reason;
+  FidelityPilot pilot;
 };
 
 // {"scene", "fidelity", "seed", "threads", "tosses", "settled", "unresolved", "invalid",
@@ -33,7 +44,8 @@ struct RunReport {
 //  "chi2_heads_tails": a coin's heads against tails, edge landings left out (1 dof; null for a die),
 //  "corrections": {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks"} (totals over
 //  the run; the table prints a line only when one is non-zero), "elapsed_s", "tosses_per_s"} -- p and
-//  intervals over settled tosses, faces by label (N outcomes; chi-square on N - 1 dof against every
+//  intervals over settled tosses; "partial": true when interrupted (then "tosses" is the complete
+//  prefix run, "tosses_requested" what was asked), "tosses_requested", "provenance" (provenance.hpp); faces by label (N outcomes; chi-square on N - 1 dof against every
 //  face equally likely, grouped labels weighted by their faces).
 nlohmann::json report_json(const RunReport& r);
 // A number, or null when it is not finite (JSON has no NaN or infinity; Python then sees None).
@@ -44,8 +56,13 @@ nlohmann::json chi2_json(const ChiSquare& c);
 nlohmann::json corrections_json(const RunCorrections& k);
 // "corrections: N energy clamps, ... (each should be 0: the physics was repaired)", or "" when all are 0.
 std::string corrections_line(const RunCorrections& k);
-// Fills labels and faces_per_label from the model.
+// Fills labels and faces_per_label from the model, and fidelity_requested and fidelity_reason.
 void set_labels(RunReport& r, const DieModel& m);
+// auto's pilot: {"seed", "halfwidth", "precision", "fraction", "threshold", "max_pairs", "cap", "tosses",
+// "seconds", "candidates": [{"model", "pairs", "differing", "bound", "adequate"}]}, or null when none ran.
+nlohmann::json pilot_json(const FidelityPilot& p);
+// One line for a table's header: "auto chose paper: pilot of ..." (empty when no pilot ran).
+std::string pilot_line(const FidelityPilot& p, const std::string& chosen);
 std::string report_table(const RunReport& r);
 // Prints the run on stdout: one JSON object (json) or the table.
 void print_report(const RunReport& r, bool json);

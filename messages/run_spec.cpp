@@ -1,4 +1,6 @@
 #include "messages/run_spec.hpp"
+#include "messages/spec_scene.hpp"
+#include "sim/scene/scene_hash.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -172,7 +174,11 @@ std::uint64_t model_fingerprint(const DieModel& m) {
   return f.h;
 }
 
-DieModel compile_spec(const RunSpec& spec) {
+namespace {
+// Writes the run's files into a private temporary directory, calls f(the main scene's path there,
+// the overrides) and removes the directory.
+template <class F>
+auto in_spec_dir(const RunSpec& spec, F&& f) {
   if (spec.files.empty()) throw SceneError(spec.origin, "", "", "run_start carries no scene file");
   std::vector<SceneFile> all = spec.files;
   all.insert(all.end(), spec.assets.begin(), spec.assets.end());
@@ -204,7 +210,17 @@ DieModel compile_spec(const RunSpec& spec) {
     if (is_mesh_override(o) && !spec.assets.empty()) o = "die.mesh=" + toml_quoted((dir / spec.assets.back().path).string());
   // The scene's name comes from the file's stem, as in `toss`; errors name the user's path.
   const fs::path main = dir / spec.files[0].path;
-  return compile(load_scene(main.string(), overrides), spec.origin);
+  return f(main.string(), overrides);
+}
+}  // namespace
+
+DieModel compile_spec(const RunSpec& spec) {
+  return compile(in_spec_dir(spec, [](const std::string& path, const std::vector<std::string>& o) { return load_scene(path, o); }),
+                 spec.origin);
+}
+
+std::string spec_scene_sha256(const RunSpec& spec) {
+  return in_spec_dir(spec, [](const std::string& path, const std::vector<std::string>& o) { return scene_sha256(path, o); });
 }
 
 RunSpec make_run_spec(std::int64_t run_id, const std::string& scene_path, const std::vector<std::string>& overrides,

@@ -39,6 +39,8 @@ class Scene {
 
   // Loads the scene again with more overrides after its own (sweeps): as `--set` on the CLI.
   SceneDef load_with(const std::vector<std::string>& extra) const;
+  // The SHA-256 of the scene load_with(extra) loads (provenance: sim/scene/scene_hash.hpp).
+  std::string sha256_with(const std::vector<std::string>& extra) const;
 
  private:
   std::string origin_;
@@ -49,7 +51,13 @@ class Scene {
   std::map<std::string, std::shared_ptr<const DieModel>> by_fidelity_;
 };
 
-// The `fidelity=` argument as the CLI's --fidelity override text.
+// A `scene=` argument: a Scene, or a path (str or os.PathLike) loaded as load_scene(path) would.
+std::shared_ptr<Scene> scene_arg(const pb::handle& scene);
+// A count argument such as `n=`: an int, or a float that is an exact whole number (1e4); None ->
+// nullopt. A TypeError/ValueError naming `name` and the value otherwise.
+std::optional<std::uint64_t> count_arg(const pb::handle& n, const char* name);
+// The `fidelity=` argument as the CLI's --fidelity override text. A name that is not a fidelity is
+// a ValueError naming it and the choices.
 std::vector<std::string> fidelity_override(const std::optional<std::string>& fidelity);
 
 // Progress shared between the computing thread (writes) and the Python thread (reads).

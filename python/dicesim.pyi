@@ -1,4 +1,5 @@
 """Type stubs of the dicesim extension module (python/*.cpp). Docstrings: help(dicesim)."""
+import os
 from typing import Any, Callable, Iterable, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -10,6 +11,10 @@ __version__: str
 SetValue = Union[bool, int, float, str, Sequence[Any]]
 Overrides = Union[Mapping[str, SetValue], Iterable[str], None]
 Progress = Optional[Callable[[int, int], Any]]
+# A scene argument: a loaded Scene, or a path to load (as load_scene(path)).
+SceneArg = Union["Scene", str, os.PathLike[str]]
+# A count: an int, or a float that is a whole number (1e5).
+Count = Union[int, float]
 
 class SceneError(ValueError):
     """Bad scene input; str(e) is the CLI's exit-2 message."""
@@ -87,8 +92,8 @@ class Sweep:
 def load_scene(path: str, set: Overrides = None) -> Scene: ...
 def scene_from_toml(text: str, set: Overrides = None, name: str = "<string>") -> Scene: ...
 def toss(
-    scene: Scene,
-    n: Optional[int] = None,
+    scene: SceneArg,
+    n: Optional[Count] = None,
     seed: int = 1,
     threads: int = 0,
     fidelity: Optional[str] = None,
@@ -99,10 +104,10 @@ def toss_one(
     scene: Scene, index: int, seed: int = 1, fidelity: Optional[str] = None, trace: bool = True
 ) -> dict[str, Any]: ...
 def sweep(
-    scene: Scene,
+    scene: SceneArg,
     key: str,
     values: Union[str, Iterable[float]],
-    n: int,
+    n: Count,
     seed: int = 1,
     threads: int = 0,
     fidelity: Optional[str] = None,
@@ -113,7 +118,7 @@ def sweep(
 ) -> Sweep: ...
 def sweep_file(
     path: str,
-    n: Optional[int] = None,
+    n: Optional[Count] = None,
     seed: Optional[int] = None,
     threads: int = 0,
     fidelity: Optional[str] = None,
@@ -123,7 +128,7 @@ def fit(
     scene: Union[Scene, str, Sequence[Union[Scene, str]]],
     data: Union[str, Mapping[int, int], Sequence[Union[str, Mapping[int, int]]]],
     params: Union[Mapping[str, Tuple[float, float]], Sequence[str]],
-    n: int = 0,
+    n: Count = 0,
     rounds: int = 3,
     seed: int = 1,
     threads: int = 0,
@@ -131,11 +136,11 @@ def fit(
     progress: Progress = None,
 ) -> dict[str, Any]: ...
 def power(
-    scene: Scene,
+    scene: SceneArg,
     *,
     against: Optional[Scene] = None,
     detect_bias: Optional[float] = None,
-    n: int = 100000,
+    n: Count = 100000,
     alpha: float = 0.05,
     power: float = 0.8,
     replicates: int = 4000,

@@ -43,7 +43,7 @@ FaceCounts counts_of(const pb::handle& h, std::string& source) {
   throw pb::type_error("data must be a counts file path or a dict {label: count}");
 }
 
-pb::object do_fit(const pb::object& scene, const pb::object& data, const pb::object& params, std::uint64_t n, int rounds,
+pb::object do_fit(const pb::object& scene, const pb::object& data, const pb::object& params, const pb::object& n_given, int rounds,
                   std::uint64_t seed, int threads, std::optional<std::string> fidelity, const pb::object& progress) {
   if (!progress.is_none() && !PyCallable_Check(progress.ptr())) throw pb::type_error("progress must be callable or None");
   // One data set, or lists of scenes and data of the same length.
@@ -85,7 +85,7 @@ pb::object do_fit(const pb::object& scene, const pb::object& data, const pb::obj
   opt.overrides = fidelity_override(fidelity);
   opt.seed = seed;
   opt.threads = resolve_threads(threads);
-  opt.tosses = n;
+  opt.tosses = count_arg(n_given, "n").value_or(0);
   opt.rounds = rounds;
   RunMonitor monitor;
   opt.cancel = &monitor.cancel;

@@ -8,6 +8,7 @@
 #include "apps/power_report.hpp"
 #include "python/bindings.hpp"
 #include "sim/scene/scene_error.hpp"
+#include "sim/study/auto_pilot.hpp"
 
 namespace dicesim::py {
 namespace {
@@ -18,9 +19,15 @@ std::string labels_text(const std::vector<int>& labels) {
   return t + "]";
 }
 
-pb::object do_power(Scene& scene, const std::shared_ptr<Scene>& against, std::optional<double> detect_bias, std::uint64_t n,
+pb::object do_power(const pb::object& scene_given, const std::shared_ptr<Scene>& against, std::optional<double> detect_bias,
+                    const pb::object& n_given,
                     double alpha, double power, std::uint64_t replicates, int bootstrap, std::uint64_t seed, int threads,
                     std::optional<std::string> fidelity, const pb::object& progress) {
+  const std::shared_ptr<Scene> held = scene_arg(scene_given);
+  Scene& scene = *held;
+  const std::optional<std::uint64_t> counted = count_arg(n_given, "n");
+  if (!counted) throw pb::type_error("n must be a whole number, got None");
+  const std::uint64_t n = *counted;
   if ((against != nullptr) == detect_bias.has_value())
     throw pb::value_error("give exactly one of against (a Scene) or detect_bias (a shift in (0, 0.5])");
   if (!(alpha > 0.0 && alpha < 1.0)) throw pb::value_error("alpha must be in (0, 1), got " + std::to_string(alpha));
@@ -34,10 +41,18 @@ pb::object do_power(Scene& scene, const std::shared_ptr<Scene>& against, std::op
   if (bootstrap < 100 || bootstrap > 1000000) throw pb::value_error("bootstrap must be in [100, 10^6], got " + std::to_string(bootstrap));
   if (!progress.is_none() && !PyCallable_Check(progress.ptr())) throw pb::type_error("progress must be callable or None");
 
-  const std::shared_ptr<const DieModel> model = scene.model(fidelity);
+  std::shared_ptr<const DieModel> model = scene.model(fidelity);
+  // auto: each scene's pilot at the study's simulated tosses (as `dicesim power`).
+  auto resolved = [&](std::shared_ptr<const DieModel> m) -> std::shared_ptr<const DieModel> {
+    if (m->fidelity_requested != Fidelity::Auto) return m;
+    auto r = std::make_shared<DieModel>(*m);
+    resolve_auto(*r, precision_of_run(*r, n), resolve_threads(threads));
+    return r;
+  };
+  model = resolved(model);
   std::shared_ptr<const DieModel> other;
   if (against) {
-    other = against->model(fidelity);
+    other = resolved(against->model(fidelity));
     if (other->outcome_labels != model->outcome_labels)
       throw SceneError(against->origin(), "outcome labels", labels_text(other->outcome_labels),
                        "must equal those of " + scene.origin() + " " + labels_text(model->outcome_labels) +
@@ -52,6 +67,13 @@ pb::object do_power(Scene& scene, const std::shared_ptr<Scene>& against, std::op
   }
   info.seed = seed;
   info.threads = resolve_threads(threads);
+  {
+    const std::vector<std::string> extra = fidelity_override(fidelity);
+    std::vector<std::string> overrides = scene.overrides();
+    overrides.insert(overrides.end(), extra.begin(), extra.end());
+    info.provenance = make_provenance(scene.origin(), overrides, scene.sha256_with(extra), *model, seed, n, info.threads);
+    if (against) info.against_sha256 = against->sha256_with(extra);
+  }
   PowerStudyConfig& cfg = info.config;
   cfg.tosses = n;
   cfg.seed = seed;

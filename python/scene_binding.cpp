@@ -4,8 +4,14 @@
 
 #include <pybind11/stl.h>
 
+#include "sim/scene/scene_hash.hpp"
 #include "apps/info_json.hpp"
+#include "apps/report.hpp"
 #include "python/bindings.hpp"
+#include "sim/scene/fidelity.hpp"
+#include "sim/scene/scene_error.hpp"
+#include "sim/body/material_parts.hpp"
+#include "sim/study/auto_pilot.hpp"
 #include "sim/models/compile.hpp"
 
 namespace dicesim::py {
@@ -60,7 +66,37 @@ pb::object json_to_python(const nlohmann::json& j) {
 
 std::vector<std::string> fidelity_override(const std::optional<std::string>& fidelity) {
   if (!fidelity) return {};
+  if (!parse_fidelity(*fidelity))
+    throw SceneError("fidelity", "", "", "'" + *fidelity + "' is not a fidelity; " + kFidelityChoices);
   return {"sim.fidelity=\"" + *fidelity + "\""};  // as SceneArgs::load (apps/cli.cpp)
+}
+
+std::shared_ptr<Scene> scene_arg(const pb::handle& scene) {
+  if (pb::isinstance<Scene>(scene)) return scene.cast<std::shared_ptr<Scene>>();
+  if (pb::isinstance<pb::str>(scene) || pb::hasattr(scene, "__fspath__"))
+    return Scene::from_path(pb::str(pb::module_::import("os").attr("fspath")(scene)).cast<std::string>(), {});
+  throw pb::type_error("scene must be a dicesim.Scene or a path (str or os.PathLike), got " +
+                       pb::str(pb::type::of(scene).attr("__name__")).cast<std::string>());
+}
+
+std::optional<std::uint64_t> count_arg(const pb::handle& n, const char* name) {
+  if (n.is_none()) return std::nullopt;
+  const std::string text = pb::repr(n).cast<std::string>();
+  if (pb::isinstance<pb::bool_>(n)) throw pb::type_error(std::string(name) + " must be a whole number, got " + text);
+  pb::object whole;
+  if (pb::isinstance<pb::float_>(n)) {
+    if (!n.attr("is_integer")().cast<bool>())
+      throw pb::value_error(std::string(name) + " must be a whole number (100000, 1e5), got " + text);
+    whole = pb::int_(pb::reinterpret_borrow<pb::object>(n));
+  } else if (PyIndex_Check(n.ptr())) {  // int, numpy integers
+    whole = pb::reinterpret_steal<pb::object>(PyNumber_Index(n.ptr()));
+    if (!whole) throw pb::error_already_set();
+  } else {
+    throw pb::type_error(std::string(name) + " must be a whole number (int, or a float such as 1e5), got " + text);
+  }
+  if (whole < pb::int_(0) || whole > pb::int_(1ULL << 62))
+    throw pb::value_error(std::string(name) + " must be in [0, 2^62], got " + text);
+  return whole.cast<std::uint64_t>();
 }
 
 std::shared_ptr<Scene> Scene::from_path(std::string path, std::vector<std::string> overrides) {
@@ -80,6 +116,12 @@ std::shared_ptr<Scene> Scene::from_text(std::string text, std::string origin, st
   s->def_ = parse_scene(*s->text_, s->origin_, s->overrides_);
   s->model_ = std::make_shared<const DieModel>(compile(s->def_, s->origin_));
   return s;
+}
+
+std::string Scene::sha256_with(const std::vector<std::string>& extra) const {
+  std::vector<std::string> all = overrides_;
+  all.insert(all.end(), extra.begin(), extra.end());
+  return text_ ? scene_text_sha256(*text_, origin_, all) : scene_sha256(origin_, all);
 }
 
 SceneDef Scene::load_with(const std::vector<std::string>& extra) const {
@@ -116,7 +158,14 @@ void register_scene(pb::module_& m) {
           "The outcome labels: distinct face labels, ascending (the order of Result.counts).")
       .def(
           "info",
-          [](Scene& s, std::optional<std::string> fidelity) { return json_to_python(info_json(s.origin(), *s.model(fidelity))); },
+          [](Scene& s, std::optional<std::string> fidelity) {
+            DieModel m = *s.model(fidelity);
+            const FidelityPilot pilot = resolve_auto(m, precision_of_run(m, 100000), resolve_threads(0));  // as `dicesim info`
+            nlohmann::json j = info_json(s.origin(), m, material_parts(s.def(), s.origin()));
+            j["pilot"] = pilot_json(pilot);
+            if (j["pilot"].is_object()) j["pilot"].erase("seconds");  // as `dicesim info --json`
+            return json_to_python(j);
+          },
           pb::arg("fidelity") = pb::none(),
           "What the scene compiles to, as a dict: exactly `dicesim info SCENE --json`'s object (mass,\n"
           "com, inertia, principal_moments, principal_axes, faces, corners, fidelity, rest, ...).")

@@ -9,6 +9,7 @@
 #include "aggregator/target.hpp"
 #include "apps/report.hpp"
 #include "python/bindings.hpp"
+#include "sim/study/auto_pilot.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/study/monte_carlo.hpp"
 #include "sim/study/sweep.hpp"
@@ -78,9 +79,14 @@ class Result {
   std::optional<nlohmann::json> json_;
 };
 
+// `extra`: the overrides after the scene's own (fidelity=, a sweep point's key): with them the
+// scene is loaded again for its provenance (the resolved scene's hash), as the CLI reports it.
 RunReport make_report(const Scene& scene, const DieModel& model, std::uint64_t seed, int threads, std::uint64_t tosses,
-                      const RunCounts& counts, double elapsed_s) {
+                      const RunCounts& counts, double elapsed_s, const std::vector<std::string>& extra) {
   RunReport r;
+  std::vector<std::string> overrides = scene.overrides();
+  overrides.insert(overrides.end(), extra.begin(), extra.end());
+  r.provenance = make_provenance(scene.origin(), overrides, scene.sha256_with(extra), model, seed, tosses, threads);
   r.scene = scene.origin();
   r.fidelity = to_string(model.fidelity);
   r.seed = seed;
@@ -126,14 +132,26 @@ RunCounts run_cancellable(const DieModel& model, RunConfig cfg, RunMonitor& moni
 // calling overhead stays in microseconds), and cannot be interrupted.
 constexpr std::uint64_t kInlineTosses = 64;
 
-Result do_toss(Scene& scene, std::optional<std::uint64_t> n, std::uint64_t seed, int threads,
+Result do_toss(const pb::object& scene_given, const pb::object& n_given, std::uint64_t seed, int threads,
                std::optional<std::string> fidelity, std::optional<double> target_halfwidth, const pb::object& progress) {
+  const std::shared_ptr<Scene> held = scene_arg(scene_given);
+  Scene& scene = *held;
+  const std::optional<std::uint64_t> n = count_arg(n_given, "n");
   if (n && (*n < 1 || *n > (1ULL << 40))) throw pb::value_error("n must be in [1, 2^40], got " + std::to_string(*n));
   if (target_halfwidth && !(*target_halfwidth >= 1e-6 && *target_halfwidth <= 0.5))
     throw pb::value_error("target_halfwidth must be in [1e-6, 0.5], got " + std::to_string(*target_halfwidth));
   if (!progress.is_none() && !PyCallable_Check(progress.ptr())) throw pb::type_error("progress must be callable or None");
   const int nthreads = resolve_threads(threads);
-  const std::shared_ptr<const DieModel> model = scene.model(fidelity);
+  std::shared_ptr<const DieModel> model = scene.model(fidelity);
+  FidelityPilot pilot;
+  if (model->fidelity_requested == Fidelity::Auto) {  // auto: the pilot at this call's precision (as `dicesim toss`)
+    auto resolved = std::make_shared<DieModel>(*model);
+    pb::gil_scoped_release nogil;
+    pilot = resolve_auto(*resolved, target_halfwidth ? precision_of_target(*resolved, *target_halfwidth)
+                                             : precision_of_run(*resolved, n.value_or(100000)),
+                 nthreads);
+    model = std::move(resolved);
+  }
 
   RunConfig cfg;
   cfg.seed = seed;
@@ -163,7 +181,10 @@ Result do_toss(Scene& scene, std::optional<std::uint64_t> n, std::uint64_t seed,
         monitor, progress);
   }
   const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
-  return Result(make_report(scene, *model, seed, nthreads, done, counts, elapsed));
+  RunReport rep = make_report(scene, *model, seed, nthreads, done, counts, elapsed, fidelity_override(fidelity));
+  rep.provenance.tosses = tosses;  // asked for (with a target: the cap), as the CLI's
+  rep.pilot = pilot;
+  return Result(std::move(rep));
 }
 
 // A sweep: one Result per value, every point tossed with the same seed and indices 0..n-1.
@@ -198,7 +219,11 @@ Sweep run_points(Scene& scene, Sweep out, std::uint64_t n, std::uint64_t seed, i
   if (out.values.empty()) throw pb::value_error("values is empty");
   const int nthreads = resolve_threads(threads);
   std::vector<DieModel> models;
-  for (const std::vector<std::string>& extra : out.overrides) models.push_back(compile(scene.load_with(extra), scene.origin()));
+  std::vector<FidelityPilot> pilots;
+  for (const std::vector<std::string>& extra : out.overrides) {
+    models.push_back(compile(scene.load_with(extra), scene.origin()));
+    pilots.push_back(resolve_auto(models.back(), precision_of_run(models.back(), n), nthreads));  // auto: per point, as `dicesim sweep`
+  }
 
   RunMonitor monitor;
   monitor.total = n * models.size();
@@ -222,13 +247,22 @@ Sweep run_points(Scene& scene, Sweep out, std::uint64_t n, std::uint64_t seed, i
       monitor, progress);
   out.elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
   for (std::size_t i = 0; i < models.size(); ++i)
-    out.points.push_back(std::make_shared<Result>(make_report(scene, models[i], seed, nthreads, n, counts[i], elapsed[i])));
+  {
+    RunReport report = make_report(scene, models[i], seed, nthreads, n, counts[i], elapsed[i], out.overrides[i]);
+    report.pilot = pilots[i];
+    out.points.push_back(std::make_shared<Result>(std::move(report)));
+  }
   return out;
 }
 
-Sweep do_sweep(Scene& scene, const std::string& key, const pb::object& values, std::uint64_t n, std::uint64_t seed,
-               int threads, std::optional<std::string> fidelity, const std::string& value_template, double scale,
-               double shift, const pb::object& progress) {
+Sweep do_sweep(const pb::object& scene_given, const std::string& key, const pb::object& values, const pb::object& n_given,
+               std::uint64_t seed, int threads, std::optional<std::string> fidelity, const std::string& value_template,
+               double scale, double shift, const pb::object& progress) {
+  const std::shared_ptr<Scene> held = scene_arg(scene_given);
+  Scene& scene = *held;
+  const std::optional<std::uint64_t> counted = count_arg(n_given, "n");
+  if (!counted) throw pb::type_error("n must be a whole number, got None");
+  const std::uint64_t n = *counted;
   SweepParam param;
   param.key = key;
   param.value_template = value_template;
@@ -251,8 +285,9 @@ Sweep do_sweep(Scene& scene, const std::string& key, const pb::object& values, s
 }
 
 // A sweep file (scenes/paper/sweeps/*.toml), as `dicesim sweep FILE` runs it.
-Sweep do_sweep_file(const std::string& path, std::optional<std::uint64_t> n, std::optional<std::uint64_t> seed,
+Sweep do_sweep_file(const std::string& path, const pb::object& n_given, std::optional<std::uint64_t> seed,
                     int threads, std::optional<std::string> fidelity, const pb::object& progress) {
+  const std::optional<std::uint64_t> n = count_arg(n_given, "n");
   const SweepSpec spec = load_sweep_file(path);
   std::shared_ptr<Scene> scene = Scene::from_path(spec.scene, spec.overrides);
   Sweep out;
@@ -331,8 +366,10 @@ void register_toss(pb::module_& m) {
         "Tosses the die n times (default 100000) and returns the counts per face: `dicesim toss`.\n"
         "Toss i draws its throw from (seed, i) only, so the same scene, fidelity, seed and n give\n"
         "the same counts as the command line, on any number of threads.\n\n"
+        "scene: a Scene, or a path (str or os.PathLike) loaded as load_scene(path). n: an int, or a\n"
+        "float that is a whole number (1e5).\n"
         "threads: 0 = all cores. fidelity: 'static', 'paper', 'impulse', 'stepped' or 'auto' (None:\n"
-        "the scene's). target_halfwidth=H: stop at the first block of 10000 tosses (in index order)\n"
+        "the scene's; another name is a SceneError naming it and the choices). target_halfwidth=H: stop at the first block of 10000 tosses (in index order)\n"
         "where every face's 95% half-width is <= H; n is then the most it may take (default 1e9).\n"
         "progress: a callable progress(done, total), called about every 0.1 s from this thread.\n\n"
         "The GIL is released while tossing (other Python threads run, and tosses in several threads\n"

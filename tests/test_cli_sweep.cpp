@@ -98,6 +98,8 @@ TEST(CliSweep, CsvColumnsAndVectorTemplate) {
   std::istringstream in(r.out);
   std::string line;
   std::getline(in, line);
+  EXPECT_EQ(line.rfind("# provenance {\"", 0), 0u) << line;  // what made it, as one JSON line
+  std::getline(in, line);
   EXPECT_EQ(line, "param,face,count,p,lo,hi");
   int rows = 0;
   double p_sum = 0;

@@ -180,6 +180,7 @@ std::string error_of(const std::string& path) {
 // The JSON without the keys that legitimately differ between runs (as tests/integration does).
 nlohmann::json stable(nlohmann::json j) {
   for (const char* k : {"elapsed_s", "tosses_per_s", "threads"}) j.erase(k);
+  if (j.contains("provenance")) j["provenance"].erase("threads");
   return j;
 }
 

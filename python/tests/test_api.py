@@ -32,13 +32,28 @@ def test_to_dict_is_cli_json(dicesim, args):
     assert d["elapsed_s"] == pytest.approx(r.elapsed_s)
 
 
+def test_auto_is_resolved_as_the_cli_does(dicesim):
+    # A scene that names no model runs auto: the same pilot, choice and counts as `dicesim toss`.
+    caught = "scenes/coins/quarter-caught.toml"
+    r = dicesim.toss(dicesim.load_scene(caught), 100000, seed=4, threads=2)
+    d = r.to_dict()
+    assert d["fidelity_requested"] == "auto" and d["fidelity"] == "paper"
+    assert d["pilot"]["candidates"][-1]["adequate"] and d["pilot"]["tosses"] > 0
+    expected = cli_json("toss", caught, "-n", "100000", "--seed", "4", "--threads", "2")
+    assert without_timing(d) == without_timing(expected)
+
+
 def test_overrides_are_the_clis_set(dicesim):
     scene = dicesim.load_scene(DIE1, set={"materials.steel.restitution": 0.9, "throw.height.mean": 0.5,
                                           "sim.fidelity": "paper"})
     r = dicesim.toss(scene, 5000, seed=2)
     expected = cli_json("toss", DIE1, "-n", "5000", "--seed", "2", "--set", "materials.steel.restitution=0.9",
                         "--set", "throw.height.mean=0.5", "--set", "sim.fidelity=paper")
-    assert without_timing(r.to_dict()) == without_timing({**expected, "threads": r.threads})
+    d, e = without_timing(r.to_dict()), without_timing({**expected, "threads": r.threads})
+    # Python writes a string value quoted (sim.fidelity="paper"), the CLI took it bare: the overrides'
+    # text and the threads differ, the resolved scene is the same.
+    assert d.pop("provenance")["scene_sha256"] == e.pop("provenance")["scene_sha256"]
+    assert d == e
     # and the override changed something (else the comparison above proves little)
     plain = dicesim.toss(dicesim.load_scene(DIE1), 5000, seed=2)
     assert list(plain.counts) != list(r.counts)

@@ -1,4 +1,5 @@
 #include "sim/body/body.hpp"
+#include "sim/body/material_parts.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -30,10 +31,15 @@ using SolidMoments = std::function<VolumeMoments(const std::vector<HalfSpace>&)>
 
 // Regions must each cover some of the die and must not overlap: the density field is then
 // unambiguous, and mass properties are the exact sum over regions.
-void check_regions(const DieDef& die, const SolidMoments& solid, double volume, const std::string& origin) {
+// `parts` (if given): the die's volume and each region's, for material_parts (`info`).
+void check_regions(const DieDef& die, const SolidMoments& solid, double volume, const std::string& origin,
+                   std::vector<double>* parts) {
   const double tiny = 1e-9 * volume;
+  if (parts) parts->assign(1, volume);
   for (std::size_t k = 0; k < die.regions.size(); ++k) {
-    if (solid(die.regions[k].half_spaces).volume <= tiny)
+    const double v = solid(die.regions[k].half_spaces).volume;
+    if (parts) parts->push_back(v);
+    if (v <= tiny)
       throw SceneError(origin, region_key(k) + ".cuts", "", "the cuts leave no part of the die for this region");
     for (std::size_t j = 0; j < k; ++j) {
       std::vector<HalfSpace> both = die.regions[j].half_spaces;
@@ -124,10 +130,10 @@ void vertex_materials(const DieDef& die, const std::map<std::string, MaterialDef
 }
 
 // Today's box, bit for bit (the paper regression counts depend on it).
-Body build_box(const SceneDef& scene, const std::string& origin) {
+Body build_box(const SceneDef& scene, const std::string& origin, std::vector<double>* parts) {
   const DieDef& die = scene.die;
   const SolidMoments solid = [&](const std::vector<HalfSpace>& cuts) { return clipped_box_moments(die.size, cuts); };
-  check_regions(die, solid, die.size.prod(), origin);
+  check_regions(die, solid, die.size.prod(), origin, parts);
   Body b;
   b.kind = "box";
   b.shape = box_shape(die.size);
@@ -153,7 +159,7 @@ ConvexShape hull_or_error(const std::vector<Vec3>& points, const std::string& or
 }
 
 // A cylinder: exact mass properties (regions included) and per-rim materials.
-Body build_cylinder(const SceneDef& scene, const std::string& origin) {
+Body build_cylinder(const SceneDef& scene, const std::string& origin, std::vector<double>* parts) {
   const DieDef& die = scene.die;
   Body b;
   b.kind = "cylinder";
@@ -162,7 +168,7 @@ Body build_cylinder(const SceneDef& scene, const std::string& origin) {
     throw SceneError(origin, "die.rounding", num(die.rounding), "must be below min(radius, height/2)");
   const CylinderShape c = b.cylinder;
   const SolidMoments solid = [c](const std::vector<HalfSpace>& cuts) { return cylinder_moments(c, cuts); };
-  check_regions(die, solid, solid({}).volume, origin);
+  check_regions(die, solid, solid({}).volume, origin, parts);
   b.face_labels = {die.cylinder_labels[0], die.cylinder_labels[1], die.cylinder_labels[2]};
   b.mass = layered_mass(die, scene.materials, solid);
   if (!(b.mass.mass > 0.0) || !b.mass.inertia.allFinite())
@@ -199,12 +205,11 @@ Body build_cylinder(const SceneDef& scene, const std::string& origin) {
   return b;
 }
 
-}  // namespace
-
-Body build_body(const SceneDef& scene, const std::string& origin) {
+// The body, and (if `parts` is given) the volumes check_regions measures.
+Body build_body_measured(const SceneDef& scene, const std::string& origin, std::vector<double>* parts) {
   const DieDef& die = scene.die;
-  if (die.shape == ShapeKind::Cylinder) return build_cylinder(scene, origin);
-  if (die.shape == ShapeKind::Box && die.rounding == 0.0) return build_box(scene, origin);
+  if (die.shape == ShapeKind::Cylinder) return build_cylinder(scene, origin, parts);
+  if (die.shape == ShapeKind::Box && die.rounding == 0.0) return build_box(scene, origin, parts);
 
   Body b;
   b.kind = kShapeNames[static_cast<int>(die.shape)];
@@ -260,12 +265,33 @@ Body build_body(const SceneDef& scene, const std::string& origin) {
 
   b.face_labels = face_labels(b.shape, die, origin);
   b.read_down = die.read_down.value_or(die.shape == ShapeKind::D4);
-  check_regions(die, solid, volume, origin);
+  check_regions(die, solid, volume, origin, parts);
   b.mass = layered_mass(die, scene.materials, solid);
   if (!(b.mass.mass > 0.0) || !b.mass.inertia.allFinite())
     throw SceneError(origin, "die", "", "the die has no mass; check its size and the densities");
   vertex_materials(die, scene.materials, b.shape, b.vertex_restitution, b.vertex_friction);
   return b;
+}
+
+}  // namespace
+
+Body build_body(const SceneDef& scene, const std::string& origin) { return build_body_measured(scene, origin, nullptr); }
+
+std::vector<MaterialPart> material_parts(const SceneDef& scene, const std::string& origin) {
+  std::vector<double> volumes;  // the die's, then each region's
+  build_body_measured(scene, origin, &volumes);
+  const DieDef& die = scene.die;
+  std::vector<MaterialPart> parts;
+  double in_regions = 0.0;
+  for (std::size_t k = 1; k < volumes.size(); ++k) in_regions += volumes[k];
+  const double base_density = scene.materials.at(die.base_material).density;
+  const double base_volume = std::max(0.0, volumes.at(0) - in_regions);  // regions are disjoint (checked)
+  parts.push_back({"base", die.base_material, base_density, base_volume, base_density * base_volume});
+  for (std::size_t k = 0; k < die.regions.size() && k + 1 < volumes.size(); ++k) {
+    const double rho = scene.materials.at(die.regions[k].material).density;
+    parts.push_back({"region " + std::to_string(k), die.regions[k].material, rho, volumes[k + 1], rho * volumes[k + 1]});
+  }
+  return parts;
 }
 
 }  // namespace dicesim

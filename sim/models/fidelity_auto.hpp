@@ -1,5 +1,7 @@
-// `fidelity = "auto"`: the cheapest model that the scene's features need, decided once when the
-// scene is compiled (never per toss), with the reason in words for `dicesim info`.
+// The fidelity a compiled model starts with. A stated model is taken as stated. `auto` cannot be
+// decided at compile time: it needs the run's precision, so compile() keeps Auto requested and
+// tosses `impulse` (the safe answer) until resolve_auto (sim/study/auto_pilot.hpp) measures
+// whether a cheaper model is adequate for the run at hand.
 #pragma once
 
 #include "sim/body/die_model.hpp"
@@ -8,7 +10,6 @@
 namespace dicesim {
 
 // Sets m.fidelity (never Auto), m.fidelity_requested and m.fidelity_reason from scene.sim.fidelity.
-// Needs m.vertex_friction.
 void resolve_fidelity(const SceneDef& scene, DieModel& m);
 
 }  // namespace dicesim

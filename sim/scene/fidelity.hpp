@@ -4,7 +4,9 @@
 //   impulse : event-driven rigid body: exact flight, Coulomb friction in the impact law,
 //             edge and face contacts solved together, sliding/rolling/tipping until rest
 //   stepped : fixed-step time integration of the same physics (the reference as the step shrinks)
-//   auto    : the cheapest of the above that the scene needs; resolved when the model is compiled
+//   auto    : the cheapest model a pilot of paired tosses shows adequate for this scene at the
+//             run's precision, else impulse (sim/study/auto_pilot.hpp); a scene file that names
+//             no model runs auto
 #pragma once
 
 #include <optional>

@@ -1,6 +1,7 @@
 // Scene files: TOML -> (extends chain, --set overrides) -> one merged tree -> validated SceneDef.
 // Defaults come from the member initialisers in scene.hpp; this file only reads what a scene states.
 #include "sim/scene/scene.hpp"
+#include "sim/scene/key_unit.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -18,6 +19,7 @@
 #include <toml++/toml.h>
 
 #include "sim/scene/scene_error.hpp"
+#include "sim/scene/scene_hash.hpp"
 
 namespace dicesim {
 namespace {
@@ -559,6 +561,7 @@ void read_sim(Reader sim, SimDef& def) {
 
 SceneDef build(const toml::table& tree, const std::string& origin, const std::string& default_name) {
   SceneDef s = default_scene_def();
+  s.sim.fidelity = Fidelity::Auto;  // a scene file that names no model gets the measured choice (issue 35)
   Reader top(&tree, "", origin);
   s.name = top.string("name").value_or(default_name);
   if (s.name.empty()) top.fail(top.get("name"), "name", "must be a non-empty string");
@@ -776,6 +779,13 @@ std::string stem_or(const std::string& path, const std::string& fallback) {
   return stem.empty() ? fallback : stem;
 }
 
+// The resolved tree's hash (scene_hash.hpp); build() validates it and reads a mesh's OBJ.
+std::string tree_sha256(toml::table tree, const std::string& origin, const std::vector<std::string>& overrides) {
+  for (const std::string& o : overrides) apply_override(tree, o, origin);
+  const SceneDef def = build(tree, origin, stem_or(origin, "scene"));
+  return sha256_hex(canonical_scene_text(tree, def.die.mesh_text));
+}
+
 SceneDef finish_tree(toml::table tree, const std::string& origin, const std::vector<std::string>& overrides) {
   for (const std::string& o : overrides) apply_override(tree, o, origin);
   return build(tree, origin, stem_or(origin, "scene"));
@@ -795,6 +805,67 @@ SceneDef parse_scene(const std::string& toml_text, const std::string& origin, co
   std::vector<ChainLink> chain;
   toml::table tree = resolve_extends(parse_toml(toml_text, origin), origin, fs::current_path(), chain);
   return finish_tree(std::move(tree), origin, overrides);
+}
+
+std::string scene_sha256(const std::string& path, const std::vector<std::string>& overrides) {
+  std::vector<ChainLink> chain;
+  if (fs::is_regular_file(path)) chain.push_back({fs::weakly_canonical(path), fs::path(path)});
+  return tree_sha256(load_tree(path, chain), path, overrides);
+}
+
+std::string scene_text_sha256(const std::string& toml_text, const std::string& origin, const std::vector<std::string>& overrides) {
+  std::vector<ChainLink> chain;
+  return tree_sha256(resolve_extends(parse_toml(toml_text, origin), origin, fs::current_path(), chain), origin, overrides);
+}
+
+}  // namespace dicesim
+
+namespace dicesim {
+
+std::string key_unit(std::string_view key) {
+  // The key without indices, and any material's name as "*": "materials.*.density".
+  std::string k;
+  for (std::size_t i = 0; i < key.size(); ++i) {
+    if (key[i] == '[') {
+      while (i < key.size() && key[i] != ']') ++i;
+      continue;
+    }
+    k += key[i];
+  }
+  if (k.rfind("materials.", 0) == 0) {
+    const std::size_t dot = k.find('.', 10);
+    if (dot != std::string::npos) k = "materials.*" + k.substr(dot);
+  }
+  static const std::pair<std::string_view, const Range*> units[] = {
+      {"materials.*.density", &kDensity},
+      {"materials.*.rolling_resistance", &kRollingResistance},
+      {"materials.*.pivoting_resistance", &kPivotingResistance},
+      {"die.size", &kEdge},
+      {"die.radius", &kEdge},
+      {"die.length", &kEdge},
+      {"die.height", &kEdge},
+      {"die.rounding", &kRounding},
+      {"die.regions.cuts.offset", &kLength},
+      {"throw.orientation.euler_deg", &kAngle},
+      {"throw.height.mean", &kLength},
+      {"throw.height.sd", &kLengthSd},
+      {"throw.velocity.mean", &kSpeed},
+      {"throw.velocity.sd", &kSpeedSd},
+      {"throw.spin.mean", &kSpin},
+      {"throw.spin.sd", &kSpinSd},
+      {"throw.spin.tilt_deg", &kAngle},
+      {"throw.spin.tilt_sd_deg", &kTiltSd},
+      {"throw.catch_time.mean", &kCatchTime},
+      {"throw.catch_time.sd", &kCatchTimeSd},
+      {"sim.gravity", &kGravity},
+      {"sim.stop_speed", &kStopSpeed},
+      {"sim.max_time", &kMaxTime},
+      {"sim.step", &kStep},
+      {"sim.contact_step", &kStep},
+  };
+  for (const auto& [name, range] : units)
+    if (k == name) return range->unit;
+  return "";
 }
 
 }  // namespace dicesim

@@ -156,6 +156,8 @@ inline constexpr double kContactStepPolyhedron = 3e-3;
 inline constexpr double kContactStepCurved = 1e-3;
 
 struct SimDef {
+  // A scene file without sim.fidelity reads as Auto (build() in scene.cpp); Paper here only for
+  // scenes built in code (tests, which state their model).
   Fidelity fidelity = Fidelity::Paper;
   double gravity = 9.81;        // m/s^2
   double stop_speed = 0.1;      // m/s: `paper` stops when the COM's rebound speed is below this

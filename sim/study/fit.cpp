@@ -1,3 +1,4 @@
+#include "sim/study/auto_pilot.hpp"
 #include "sim/study/fit.hpp"
 
 #include <algorithm>
@@ -181,6 +182,12 @@ std::string labels_text(const std::vector<int>& v) {
   return s;
 }
 
+// auto in a fit: the scene moves across the box, and a pilot at one point says nothing of the others
+// (nor may the model change between points of one surrogate).
+constexpr const char* kFitAutoReason =
+    "auto: `impulse` (no pilot): a fit moves the scene across its box, where a cheaper model shown adequate at one "
+    "point may not be at another, and one model must serve every point";
+
 class Fitter {
  public:
   Fitter(const std::vector<FitParam>& params, const std::vector<FitData>& data, const FitOptions& opt)
@@ -196,7 +203,9 @@ class Fitter {
     return all;
   }
   DieModel model_at(std::size_t s, const VectorXd& theta) const {
-    return compile(load_scene(data_[s].scene, overrides_at(s, theta)), data_[s].scene);
+    DieModel m = compile(load_scene(data_[s].scene, overrides_at(s, theta)), data_[s].scene);
+    resolve_auto_unmeasured(m, kFitAutoReason);
+    return m;
   }
   std::vector<VectorXd> grid(const Box& box) const { return box_grid(box, fit_grid_points(d_)); }
   // Tosses every model with indices 0..tosses-1 in `batches` batches on the thread pool.
@@ -446,6 +455,7 @@ FitResult Fitter::run() {
 
   FitResult res;
   res.fidelity = to_string(models.front().front().fidelity);
+  res.fidelity_reason = models.front().front().fidelity_reason;
   Surrogate sur{Basis(d_, 0), box, {}};
   std::vector<std::vector<PointCounts>> counts;
   VectorXd theta(d_);

@@ -110,6 +110,7 @@ struct FitResult {
   std::vector<FitDataResult> data;
   ChiSquare gof;  // all data sets together, dof = sum(outcomes - 1) - parameters
   std::string fidelity;  // the first data set's model's (after --fidelity / sim.fidelity)
+  std::string fidelity_reason;  // why (auto in a fit: impulse, no pilot)
   double loglik = 0.0;
   std::uint64_t simulated_tosses = 0;
   double elapsed_s = 0.0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
+#include <map>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -45,25 +46,40 @@ RunCounts run_tosses(const DieModel& m, const RunConfig& cfg) {
   const int threads = static_cast<int>(std::max<std::uint64_t>(1, std::min<std::uint64_t>(cfg.threads, n_chunks)));
 
   std::atomic<std::uint64_t> next{0}, done{0};
-  std::vector<RunCounts> partial(static_cast<std::size_t>(threads), RunCounts(m.outcomes()));
-  auto work = [&](RunCounts& out) {
+  // Finished chunks join `total` in index order; one finished ahead of a gap waits in `ahead` (at
+  // most about one per thread). A cancelled run thus returns exactly the tosses 0..k-1 of its
+  // longest complete prefix: the same counts as a run of k tosses (what an interrupted toss reports).
+  RunCounts total(m.outcomes());
+  std::mutex total_mu;
+  std::uint64_t merged_chunks = 0;
+  std::map<std::uint64_t, RunCounts> ahead;
+  const auto cancelled = [&cfg] { return cfg.cancel && cfg.cancel->load(std::memory_order_relaxed); };
+  auto work = [&] {
     for (;;) {
-      if (cfg.cancel && cfg.cancel->load(std::memory_order_relaxed)) return;
+      if (cancelled()) return;
       const std::uint64_t c = next.fetch_add(1, std::memory_order_relaxed);
       if (c >= n_chunks) return;
       const std::uint64_t lo = c * chunk, hi = std::min(cfg.tosses, lo + chunk);
       RunCounts local(m.outcomes());
-      for (std::uint64_t i = lo; i < hi; ++i) local.add(toss(m, cfg.seed, cfg.first + i));
-      out.merge(local);
+      for (std::uint64_t i = lo; i < hi; ++i) {
+        if (cancelled()) return;  // this chunk is dropped: the prefix ends before it
+        local.add(toss(m, cfg.seed, cfg.first + i));
+      }
+      {
+        std::lock_guard lock(total_mu);
+        ahead.emplace(c, std::move(local));
+        for (auto it = ahead.begin(); it != ahead.end() && it->first == merged_chunks; it = ahead.erase(it), ++merged_chunks)
+          total.merge(it->second);
+      }
       done.fetch_add(hi - lo, std::memory_order_relaxed);
     }
   };
 
   {
     std::vector<std::jthread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(work, std::ref(partial[static_cast<std::size_t>(t)]));
+    for (int t = 1; t < threads; ++t) pool.emplace_back(work);
     if (!cfg.progress) {
-      work(partial[0]);
+      work();
     } else {
       // The calling thread works too, so progress comes from a mostly sleeping reporter thread,
       // woken at once when the work ends (a plain 100 ms sleep added up to 0.1 s to every run).
@@ -75,7 +91,7 @@ RunCounts run_tosses(const DieModel& m, const RunConfig& cfg) {
         while (!cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return finished; }))
           cfg.progress(done.load(), cfg.tosses);
       });
-      work(partial[0]);
+      work();
       for (auto& th : pool) th.join();
       {
         std::lock_guard lock(mu);
@@ -84,8 +100,6 @@ RunCounts run_tosses(const DieModel& m, const RunConfig& cfg) {
       cv.notify_one();
     }
   }
-  RunCounts total(m.outcomes());
-  for (const RunCounts& p : partial) total.merge(p);
   if (cfg.progress) cfg.progress(done.load(), cfg.tosses);
   return total;
 }

@@ -1,5 +1,7 @@
 #include "sim/models/compile.hpp"
+#include "sim/scene/scene_hash.hpp"
 #include "sim/study/sweep.hpp"
+#include "sim/study/auto_pilot.hpp"
 
 #include "sim/body/outcome.hpp"
 
@@ -274,11 +276,15 @@ SweepSpec load_sweep_file(const std::string& path) {
     if (!fs::is_regular_file(s.seed_table)) t.fail("seed_table", "\"" + *st + "\"", "cannot open '" + s.seed_table + "'");
   }
   s.seed_tosses = t.count("seed_tosses", 1, 1ULL << 40).value_or(0);
+  if (const auto ref = t.num("reference")) {
+    if (!(*ref > 0.0 && *ref < 1.0)) t.fail("reference", number_text(*ref), "must be a probability in (0, 1), e.g. 0.3333333333333333");
+    s.reference = *ref;
+  }
 
   const toml::node* param = t.get("param");
   const toml::node* points = t.get("points");
   t.finish({"title", "reproduces", "scene", "tosses", "seed", "set", "seed_table", "seed_tosses", "x_label", "reading",
-            "notes", "param", "points"});
+            "notes", "reference", "param", "points"});
   if ((param != nullptr) == (points != nullptr))
     t.fail(param ? "points" : "param", "", "give exactly one of [sweep.param] (a key and values) or [[sweep.points]]");
 
@@ -334,12 +340,28 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   // Every point is loaded and compiled before the first toss: a bad value fails at once.
   std::vector<DieModel> models;
+  std::vector<FidelityPilot> pilots;
   std::vector<std::vector<std::string>> overrides;
+  std::vector<std::string> hashes;
   models.reserve(spec.points.size());
   for (const SweepPoint& p : spec.points) {
     std::vector<std::string> all = spec.overrides;
     all.insert(all.end(), p.overrides.begin(), p.overrides.end());
-    models.push_back(compile(load_scene(spec.scene, all), spec.scene));
+    // A point that fails says which point: its key and value may differ from the one that broke.
+    const std::string where = "sweep point " + spec.x_label + " = " + p.label;
+    try {
+      models.push_back(compile(load_scene(spec.scene, all), spec.scene));
+      hashes.push_back(scene_sha256(spec.scene, all));
+    } catch (const SceneError& e) {
+      throw SceneError(e.file(), e.key(), e.value(), e.allowed() + " (at " + where + ")");
+    } catch (const std::exception& e) {
+      throw std::runtime_error(where + ": " + e.what());
+    }
+    // auto: each point's own pilot at the sweep's tosses per point (a point's scene is its own);
+    // the choice is passed on as an override, so that workers of a distributed sweep toss it too.
+    pilots.push_back(resolve_auto(models.back(), precision_of_run(models.back(), spec.tosses), opt.threads));
+    if (models.back().fidelity_requested == Fidelity::Auto)
+      all.push_back(std::string("sim.fidelity=\"") + to_string(models.back().fidelity) + "\"");
     // One table: the same outcomes at every point (a sweep of die.sides is a sweep per die).
     const std::vector<int>& labels = models.back().outcome_labels;
     auto text = [](const std::vector<int>& v) {
@@ -381,10 +403,19 @@ SweepResult run_sweep(const SweepSpec& spec, const SweepRunOptions& opt) {
         cfg.progress = [&opt, before, total](std::uint64_t done, std::uint64_t) { opt.progress(before + done, total); };
       r.counts = run_tosses(models[i], cfg);
     }
-    if (opt.cancel && opt.cancel->load()) break;  // a cancelled point is incomplete: not reported
+    const bool cancelled = opt.cancel && opt.cancel->load();
+    // A cancelled point is kept when its counts are a complete prefix (run_tosses in this process)
+    // and not empty; a distributed point's partial counts are not a prefix: dropped.
+    const bool complete = r.counts.total() >= spec.tosses;
+    if (cancelled && !complete && (opt.run_point || r.counts.total() == 0)) break;
+    r.partial = !complete;
     r.labels = models[i].outcome_labels;
     r.fidelity = to_string(models[i].fidelity);
+    r.fidelity_reason = models[i].fidelity_reason;
+    r.scene_sha256 = hashes[i];
+    r.pilot = pilots[i];
     out.points.push_back(std::move(r));
+    if (cancelled) break;
     if (opt.progress) opt.progress(before + spec.tosses, total);
   }
   out.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/study/auto_pilot.hpp"
 #include "sim/study/monte_carlo.hpp"
 #include "sim/study/statistics.hpp"
 
@@ -59,6 +60,7 @@ struct SweepSpec {
   std::string scene;                     // base scene path
   std::vector<std::string> overrides;    // applied at every point, before the point's own
   std::string x_label;                   // axis label (default: the key)
+  double reference = 0.0;                // the question's probability (a line on the plot), e.g. 1/3; 0: none
   std::vector<SweepPoint> points;
   bool categorical = false;              // points carry their own labels ([[sweep.points]])
   std::uint64_t tosses = 10000;
@@ -88,10 +90,16 @@ struct SweepPointResult {
   RunCounts counts;
   std::vector<int> labels;  // the model's outcome labels (counts.faces in this order)
   std::string fidelity;
+  std::string fidelity_reason;  // why (auto: each point's own pilot, at the sweep's tosses per point)
+  FidelityPilot pilot;
+  std::string scene_sha256;     // the point's fully resolved scene (sim/scene/scene_hash.hpp)
+  // Cancelled during this point (in-process only): counts are the complete prefix 0..k-1 of its
+  // tosses (k = counts.total() < tosses), the same as a point of k tosses.
+  bool partial = false;
 };
 
 struct SweepResult {
-  std::vector<SweepPointResult> points;
+  std::vector<SweepPointResult> points;  // those done, in order (a cancelled sweep: a prefix of the points)
   double elapsed_s = 0.0;
 };
 

@@ -26,7 +26,7 @@ echo "scenario $scenario on $scene"
 
 fail() { echo "FAIL [$scenario]: $*" >&2; for f in "$work"/*.err; do echo "--- $f" >&2; tail -n 20 "$f" >&2; done; exit 1; }
 # The JSON without the keys that legitimately differ between runs.
-stable() { sed -E 's/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//; s/"tosses_per_s":[^,}]*,?//' "$1"; }
+stable() { sed -E 's/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//g; s/"tosses_per_s":[^,}]*,?//; s/"seconds":[^,}]*,?//g' "$1"; }  # "seconds": auto's pilot time
 # Scenario (a) compares with one thread; the others use two (the counts are the same by
 # construction, tested by (a) and by the unit tests) to keep the suite short.
 reference() { "$bin" toss "$scene" --tosses "$n" --seed "$seed" --threads "${1:-2}" --json > "$work/ref.json"; }
@@ -172,7 +172,7 @@ case "$scenario" in
     "$bin" sweep "$scene" "${sweep_args[@]}" --threads 2 > "$work/ref.json" || fail "in-process sweep exited $?"
     url="udpm://239.255.76.67:$((30000 + $$ % 20000))?ttl=0"
     "$bin" worker --lcm "$url" 2> "$work/worker1.err" & pids+=($!)  # serves every run, not --once
-    strip() { jq -c 'del(.elapsed_s, .tosses_per_s, .threads, .workers)' "$1"; }
+    strip() { jq -c 'del(.elapsed_s, .tosses_per_s, .threads, .workers, .provenance.threads)' "$1"; }
     "$bin" sweep "$scene" "${sweep_args[@]}" --workers 0 --lcm "$url" > "$work/out0.json" 2> "$work/sweep0.err" ||
       fail "dicesim sweep --workers 0 --lcm exited $?"
     [ "$(strip "$work/ref.json")" = "$(strip "$work/out0.json")" ] || fail "outside-worker sweep counts differ from the in-process sweep"

@@ -76,7 +76,7 @@ host "$ns_agg" 10.231.7.10 pagg
 export LCM_DEFAULT_URL="udpm://239.255.76.67:$((30000 + $$ % 20000))?ttl=1"
 in_ns() { local ns=$1; shift; ip netns exec "$ns" "$@"; }
 
-stable() { sed -E 's/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//; s/"tosses_per_s":[^,}]*,?//' "$1"; }
+stable() { sed -E 's/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//g; s/"tosses_per_s":[^,}]*,?//; s/"seconds":[^,}]*,?//g' "$1"; }  # "seconds": auto's pilot time
 health() { grep -oE "$1 [0-9]+" "$2" | tail -n1 | grep -oE '[0-9]+$' || echo 0; }
 reference() { "$bin" toss "$scene" --tosses "$n" --seed "$seed" --threads "$1" --json > "$work/ref.json"; }
 same_as_reference() {

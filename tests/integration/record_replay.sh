@@ -20,16 +20,17 @@ seed=13
 n=150000
 # A scenario name ending in _d20 or _d4 runs the same scenario on that die (scenes/dice/):
 # everything that works for a d6 works for any number of outcomes.
+fid=()
 case "$scenario" in
-  *_d20) scene=scenes/dice/d20.toml; scenario=${scenario%_d20} ;;
-  *_d4) scene=scenes/dice/d4.toml; scenario=${scenario%_d4} ;;
+  *_d20) scene=scenes/dice/d20.toml; fid=(--fidelity paper); scenario=${scenario%_d20} ;;  # as before auto
+  *_d4) scene=scenes/dice/d4.toml; fid=(--fidelity paper); scenario=${scenario%_d4} ;;
   # A coin: the replayed report must also carry the live one's heads-against-tails test.
-  *_coin) scene=scenes/coins/quarter.toml; scenario=${scenario%_coin} ;;
+  *_coin) scene=scenes/coins/quarter.toml; fid=(--fidelity paper); scenario=${scenario%_coin} ;;  # the wire, not the physics: paper as before auto
 esac
 echo "scenario $scenario on $scene"
 
 fail() { echo "FAIL [$scenario]: $*" >&2; for f in "$work"/*.err; do echo "--- $f" >&2; tail -n 20 "$f" >&2; done; exit 1; }
-stable() { sed -E 's/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//; s/"tosses_per_s":[^,}]*,?//' "$1"; }
+stable() { sed -E 's/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//g; s/"tosses_per_s":[^,}]*,?//; s/"seconds":[^,}]*,?//g' "$1"; }  # "seconds": auto's pilot time
 same_json() {  # same_json A B what
   [ -s "$1" ] || fail "$3: no JSON in $1"
   if [ "$(stable "$1")" != "$(stable "$2")" ]; then
@@ -49,12 +50,12 @@ record() {
 live_run() {
   local k=$1; shift
   for i in $(seq "$k"); do "$bin" worker --once --log-file "$work/worker$i.jsonl" 2> "$work/worker$i.err" & pids+=($!); done
-  "$bin" aggregate "$scene" --tosses "$n" --seed "$seed" --json --timeout 150 --log-file "$work/agg.jsonl" "$@" \
+  "$bin" aggregate "$scene" "${fid[@]}" --tosses "$n" --seed "$seed" --json --timeout 150 --log-file "$work/agg.jsonl" "$@" \
     > "$work/live.json" 2> "$work/agg.err" || fail "aggregate exited $?"
 }
 
 [ "$scenario" = live ] && n=50000
-"$bin" toss "$scene" --tosses "$n" --seed "$seed" --threads 2 --json > "$work/ref.json"
+"$bin" toss "$scene" "${fid[@]}" --tosses "$n" --seed "$seed" --threads 2 --json > "$work/ref.json"
 
 case "$scenario" in
   record)
