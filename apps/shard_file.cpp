@@ -115,6 +115,23 @@ ShardPart read_shard_file(const std::string& file) {
     r.faces_per_label = s.at("faces_per_label").get<std::vector<int>>();
     r.names = s.at("names").get<std::vector<std::string>>();
     r.counts = counts_from(s.at("counts"));
+    // prov's provenance (apps/provenance.hpp), when the toss wrote one: the merged report carries it,
+    // and its version (git describe) and resolved-scene SHA-256 must agree across shards too.
+    if (j.contains("provenance")) {
+      const auto& v = j.at("provenance");
+      Provenance& pv = r.provenance;
+      pv.version = v.at("version").get<std::string>();
+      pv.dirty = v.at("dirty").is_null() ? -1 : (v.at("dirty").get<bool>() ? 1 : 0);
+      pv.scene = v.at("scene").get<std::string>();
+      pv.scene_sha256 = v.at("scene_sha256").get<std::string>();
+      pv.overrides = v.at("overrides").get<std::vector<std::string>>();
+      pv.fidelity = v.at("fidelity").get<std::string>();
+      pv.fidelity_requested = v.at("fidelity_requested").get<std::string>();
+      pv.fidelity_reason = v.at("fidelity_reason").get<std::string>();
+      pv.seed = v.at("seed").get<std::uint64_t>();
+      pv.tosses = v.at("tosses").get<std::uint64_t>();
+      pv.threads = v.at("threads").get<int>();
+    }
   } catch (const nlohmann::json::exception& e) {
     throw ShardError(file + ": not a readable shard file (" + e.what() + ")");
   }
@@ -140,6 +157,8 @@ RunReport merge_shards(const std::vector<ShardPart>& parts) {
   for (const ShardPart& p : parts) {
     require_same(first, p, first.header.version, p.header.version, "dicesim version");
     require_same(first, p, first.header.scene_hash, p.header.scene_hash, "scene hash");
+    require_same(first, p, first.report.provenance.version, p.report.provenance.version, "build (provenance version)");
+    require_same(first, p, first.report.provenance.scene_sha256, p.report.provenance.scene_sha256, "scene sha256");
     require_same(first, p, first.header.fingerprint, p.header.fingerprint, "model fingerprint");
     require_same(first, p, first.report.fidelity, p.report.fidelity, "fidelity");
     require_same(first, p, std::to_string(first.report.seed), std::to_string(p.report.seed), "seed");
@@ -159,6 +178,8 @@ RunReport merge_shards(const std::vector<ShardPart>& parts) {
       throw ShardError("shard " + std::to_string(i) + "/" + std::to_string(n) + " is missing (" +
                        std::to_string(parts.size()) + " of " + std::to_string(n) + " shards given, first " + first.file + ")");
   r.tosses = first.header.total;
+  r.provenance.tosses = first.header.total;
+  r.provenance.threads = r.threads;
   return r;
 }
 
