@@ -6,6 +6,8 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "messages/lcm_wait.hpp"
+
 namespace dicesim::agg {
 namespace {
 
@@ -78,7 +80,7 @@ SessionResult run_session(const SessionOptions& opt, const AggregatorConfig& cfg
       res.end = SessionEnd::Cancelled;
       break;
     }
-    bus.handleTimeout(10);
+    wire::handle_timeout(bus, 10);
     const double now = seconds_since(t0);
     if (now - last_tick >= 0.02) {
       last_tick = now;

@@ -158,6 +158,8 @@ int run_cli(int argc, char** argv) {
   register_replay(app, exit_code);
   register_show(app, exit_code);
   register_serve(app, exit_code);
+  register_merge(app, exit_code);
+  register_hub(app, exit_code);
   register_version(app, exit_code);
   app.set_version_flag("--version", std::string("dicesim ") + git_describe(), "Print the version and exit (dicesim version: the build)");
   accept_number_forms(app);

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "apps/commands.hpp"
+#include "apps/lcm_hub.hpp"
 #include "apps/worker_processes.hpp"
 #include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
@@ -21,6 +22,7 @@ void on_stop_signal(int) { g_stop = true; }
 struct RunArgs {
   AggregateArgs agg;
   int workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  std::string transport = "udp";  // udp: multicast on this host; tcp: a hub of its own (apps/lcm_hub.hpp)
 };
 
 int run_run(const RunArgs& a) {
@@ -31,8 +33,20 @@ int run_run(const RunArgs& a) {
   const std::int64_t run_id = prepared.spec.run_id;
   // --lcm or $LCM_DEFAULT_URL if given; else the host-confined group on a port of this run's own.
   std::string url = wire::resolve_url(a.agg.lcm);
-  if (a.agg.lcm.empty() && url == wire::kDefaultUrl)
+  HubProcess hub;  // --transport tcp: LCM's TCP hub, started before any worker, stopped last
+  if (a.transport == "tcp") {
+    if (!a.agg.lcm.empty()) {
+      std::fprintf(stderr, "dicesim: error: --transport tcp starts a hub of its own; with --lcm %s leave it out\n", a.agg.lcm.c_str());
+      return kExitBadInput;
+    }
+    if (const std::string why = hub.start(); !why.empty()) {
+      std::fprintf(stderr, "dicesim: failed: --transport tcp: %s\n", why.c_str());
+      return kExitFailed;
+    }
+    url = hub.url();
+  } else if (a.agg.lcm.empty() && url == wire::kDefaultUrl) {
     url = private_lcm_url();
+  }
 
   std::signal(SIGINT, on_stop_signal);
   std::signal(SIGTERM, on_stop_signal);
@@ -68,7 +82,8 @@ void register_run(CLI::App& app, int& exit_code) {
       "  dicesim run scenes/paper/die1.toml --workers 2 --tosses 1000000\n"
       "  dicesim run scenes/paper/die3.toml --workers 4 --target-halfwidth 0.001 --json\n"
       "  dicesim run scenes/fair.toml --workers 2 --trace-every 500 --lcm 'udpm://239.255.76.67:7667?ttl=0'  # for lcm-spy\n"
-      "  dicesim run scenes/paper/die1.toml --workers 2 --key-file run.key   # an authenticated run");
+      "  dicesim run scenes/paper/die1.toml --workers 2 --key-file run.key   # an authenticated run\n"
+      "  dicesim run scenes/paper/die1.toml --workers 2 --transport tcp      # no multicast: a TCP hub of its own");
   args->agg.add_to(cmd);
   // Unlike every other command, `run` does not default to the shared URL: see run_run.
   cmd->get_option("--lcm")->description(
@@ -78,6 +93,12 @@ void register_run(CLI::App& app, int& exit_code) {
   cmd->add_option("-w,--workers", args->workers, "Worker processes (default: all cores)")
       ->capture_default_str()
       ->check(CLI::Range(1, 256));
+  cmd->add_option("--transport", args->transport,
+                  "udp: LCM multicast on this host (default); tcp: start LCM's TCP hub (dicesim hub) on a free\n"
+                  "port and run over tcpq://127.0.0.1:PORT, for hosts whose multicast is off (needs liblcm-java\n"
+                  "and a Java runtime; the hub listens on every interface while the run lasts)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"udp", "tcp"}));
   cmd->callback([args, &exit_code] { exit_code = run_run(*args); });
 }
 

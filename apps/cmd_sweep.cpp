@@ -29,6 +29,7 @@
 #include "sim/models/compile.hpp"
 #include "sim/scene/key_unit.hpp"
 #include "sim/study/compare.hpp"
+#include "sim/study/shard.hpp"
 #include "sim/scene/scene_error.hpp"
 #include "sim/scene/scene_hash.hpp"
 #include "sim/study/sweep.hpp"
@@ -55,6 +56,7 @@ struct SweepArgs {
   std::string lcm;           // the bus for distributed points (default: a private host-confined URL)
   bool json = false;
   std::string csv, plot, markdown;
+  std::string points;        // --points I/N: shard I of N of the points
   bool distributed() const { return workers > 0 || !lcm.empty(); }
 };
 
@@ -468,6 +470,20 @@ int run_sweep_cmd(SweepArgs a) {
   }
   if (a.tosses) spec.tosses = a.tosses;
   if (a.seed_opt->count()) spec.seed = a.seed;
+  if (!a.points.empty()) {
+    // Every point tosses the same indices with the same seed (common random numbers): a point's
+    // counts do not depend on which other points run, so shard I/N is a contiguous block of points.
+    Shard shard;
+    try {
+      shard = parse_shard(a.points);
+    } catch (const std::invalid_argument& e) {
+      throw SceneError("dicesim sweep", "--points", a.points, e.what());
+    }
+    const IndexRange block = shard_range(spec.points.size(), shard);
+    if (block.tosses == 0) throw SceneError("dicesim sweep", "--points", a.points, "this shard has no points (more shards than points)");
+    spec.points = std::vector<SweepPoint>(spec.points.begin() + static_cast<std::ptrdiff_t>(block.first),
+                                          spec.points.begin() + static_cast<std::ptrdiff_t>(block.first + block.tosses));
+  }
   if (!a.plot.empty()) {
     const std::string ext = fs::path(a.plot).extension().string();
     if (ext != ".png" && ext != ".svg") throw SceneError("dicesim sweep", "--plot", a.plot, "must end in .png or .svg");
@@ -564,6 +580,10 @@ void register_sweep(CLI::App& app, int& exit_code) {
                   "private host-confined URL, or $LCM_DEFAULT_URL if set)")
       ->type_name("URL");
   cmd->add_flag("--json", a->json, "Print exactly one JSON object on stdout instead of the table");
+  cmd->add_option("--points", a->points,
+                  "Run only shard I of N of the points (I = 0..N-1, a contiguous block in order), for job arrays:\n"
+                  "a point's counts are the same as in the whole sweep (docs/scaling-out.md)")
+      ->type_name("I/N");
   cmd->add_option("--csv", a->csv, "Write CSV: param,face,count,p,lo,hi ('-': stdout)")->type_name("FILE");
   cmd->add_option("--plot", a->plot, "Write a plot, FILE.png or FILE.svg (needs gnuplot)")->type_name("FILE");
   cmd->add_option("--markdown", a->markdown, "Write a Markdown table (beside the seed's, for sweep files)")->type_name("FILE");

@@ -1,6 +1,7 @@
 // dicesim toss: Monte Carlo probabilities of each face, in this process.
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <thread>
 
 #include "aggregator/target.hpp"
@@ -8,6 +9,7 @@
 #include "apps/interrupt.hpp"
 #include "apps/progress.hpp"
 #include "apps/report.hpp"
+#include "apps/shard_file.hpp"
 #include "sim/body/die_model.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/scene/scene_hash.hpp"
@@ -25,6 +27,8 @@ struct TossArgs {
   bool json = false;
   double target_halfwidth = 0.0;
   CLI::Option* tosses_opt = nullptr;
+  std::string shard;  // --shard I/N
+  std::string out;    // --out FILE: the shard file for `dicesim merge`
 };
 
 int run_toss(const TossArgs& a) {
@@ -34,18 +38,45 @@ int run_toss(const TossArgs& a) {
   const FidelityPilot pilot = resolve_auto(model,
                a.target_halfwidth > 0.0 ? precision_of_target(model, a.target_halfwidth) : precision_of_run(model, a.tosses),
                a.threads);
+  Shard shard;
+  if (!a.shard.empty()) {
+    try {
+      shard = parse_shard(a.shard);
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "dicesim: error: --shard %s\n", e.what());
+      return kExitBadInput;
+    }
+  }
+  if ((!a.shard.empty() || !a.out.empty()) && a.target_halfwidth > 0.0) {
+    std::fprintf(stderr, "dicesim: error: --shard/--out and --target-halfwidth exclude each other (a shard tosses a fixed block)\n");
+    return kExitBadInput;
+  }
+  std::ofstream out_file;
+  if (!a.out.empty()) {
+    out_file.open(a.out);
+    if (!out_file) {
+      std::fprintf(stderr, "dicesim: error: --out %s: cannot write it\n", a.out.c_str());
+      return kExitBadInput;
+    }
+  }
+  // The whole run is a.tosses; this process tosses its block (all of it without --shard).
+  const IndexRange block = shard_range(a.tosses, shard);
+  std::vector<std::string> overrides = a.scene.overrides;
+  if (!a.scene.fidelity.empty()) overrides.push_back("sim.fidelity=\"" + a.scene.fidelity + "\"");
+  const ShardHeader header = a.out.empty() ? ShardHeader{} : make_shard_header(a.scene.path, overrides, model, a.tosses, shard);
 
   const InterruptGuard interrupt;
   ProgressBar bar;
   RunConfig cfg;
   cfg.cancel = InterruptGuard::flag();
   cfg.seed = a.seed;
-  cfg.tosses = a.tosses;
+  cfg.first = block.first;
+  cfg.tosses = block.tosses;
   cfg.threads = a.threads;
   cfg.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
 
   const auto t0 = std::chrono::steady_clock::now();
-  std::uint64_t tosses = a.tosses;
+  std::uint64_t tosses = block.tosses;
   const bool target = a.target_halfwidth > 0.0;
   // With a target and no explicit --tosses, N is only a generous cap.
   const std::uint64_t cap = target && a.tosses_opt->count() == 0 ? 1'000'000'000ULL : a.tosses;
@@ -59,7 +90,7 @@ int run_toss(const TossArgs& a) {
 
   // Interrupted before the end: the counts are the longest complete prefix (monte_carlo.hpp). A
   // signal after the last toss, or once the target was reached, leaves the answer whole.
-  const bool partial = InterruptGuard::interrupted() && counts.total() < (target ? cap : a.tosses) &&
+  const bool partial = InterruptGuard::interrupted() && counts.total() < (target ? cap : block.tosses) &&
                        !(target && agg::halfwidth_reached(counts, a.target_halfwidth));
   if (partial) tosses = counts.total();
   RunReport r;
@@ -74,6 +105,13 @@ int run_toss(const TossArgs& a) {
   set_labels(r, model);
   r.pilot = pilot;
   r.elapsed_s = elapsed;
+  if (!a.out.empty() && !partial) {  // an interrupted shard is no shard: nothing for merge
+    out_file << shard_json(r, header).dump() << '\n';
+    if (!out_file.flush()) {
+      std::fprintf(stderr, "dicesim: failed: cannot write --out %s\n", a.out.c_str());
+      return kExitFailed;
+    }
+  }
   print_report(r, a.json);
   if (partial) std::fprintf(stderr, "dicesim: interrupted after %llu of %llu tosses\n", static_cast<unsigned long long>(tosses),
                             static_cast<unsigned long long>(r.provenance.tosses));
@@ -94,7 +132,8 @@ void register_toss(CLI::App& app, int& exit_code) {
       "  dicesim toss scenes/paper/die1.toml\n"
       "  dicesim toss scenes/paper/die1.toml --tosses 1000000 --threads 2 --json\n"
       "  dicesim toss scenes/fair.toml --set throw.height.mean=0.5 --set sim.stop_speed=0.01\n"
-      "  dicesim toss scenes/paper/die3.toml --target-halfwidth 0.002   # as many tosses as that takes");
+      "  dicesim toss scenes/paper/die3.toml --target-halfwidth 0.002   # as many tosses as that takes\n"
+      "  dicesim toss scenes/paper/die1.toml -n 1000000 --shard 3/16 --out part-3.json   # then: dicesim merge part-*.json");
   cmd->footer(
       "\nWhich fidelity (--fidelity; scenes/README.md, docs/fidelity.md):\n"
       "  auto     the cheapest model measured adequate for this scene at this run's precision, else\n"
@@ -119,6 +158,15 @@ void register_toss(CLI::App& app, int& exit_code) {
                   "(deterministic: the same stopping point on any number of threads or workers)")
       ->type_name("H")
       ->check(CLI::Range(1e-6, 0.5));
+  cmd->add_option("--shard", args->shard,
+                  "Toss shard I of N (I = 0..N-1) of the --tosses run: the contiguous index block\n"
+                  "[floor(T*I/N), floor(T*(I+1)/N)) of T tosses. `dicesim merge` adds N shards' --out files\n"
+                  "into the counts of one toss of all T (docs/scaling-out.md)")
+      ->type_name("I/N");
+  cmd->add_option("--out", args->out,
+                  "Also write the report as a shard file for `dicesim merge` (the --json report plus a \"shard\"\n"
+                  "object: version, scene hash, model fingerprint, block, raw counts); stdout is unchanged")
+      ->type_name("FILE");
   cmd->add_flag("--json", args->json, "Print exactly one JSON object on stdout instead of the table");
   cmd->callback([args, &exit_code] { exit_code = run_toss(*args); });
 }

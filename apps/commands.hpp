@@ -51,6 +51,8 @@ void register_bridge(CLI::App& app, int& exit_code);  // cmd_bridge.cpp
 void register_watch(CLI::App& app, int& exit_code);   // cmd_watch.cpp
 void register_record(CLI::App& app, int& exit_code);  // cmd_record.cpp
 void register_replay(CLI::App& app, int& exit_code);  // cmd_replay.cpp
+void register_merge(CLI::App& app, int& exit_code);   // cmd_merge.cpp: shards of `toss --shard`
+void register_hub(CLI::App& app, int& exit_code);     // cmd_hub.cpp: LCM's TCP hub
 void register_version(CLI::App& app, int& exit_code); // cmd_version.cpp
 
 // Distributed runs (cmd_aggregate.cpp): what `aggregate` and `run` share.

@@ -9,6 +9,8 @@
 #include <Eigen/Geometry>
 #include <lcm/lcm-cpp.hpp>
 
+#include "messages/lcm_wait.hpp"
+
 #include "sim/scene/scene_error.hpp"
 #include "sim/models/toss.hpp"
 
@@ -339,12 +341,12 @@ int run_worker(const WorkerOptions& opt) {
   if (opt.core.log) opt.core.log("worker " + std::to_string(core.id()) + " listening on " + opt.url);
   for (;;) {
     if (opt.cancel && opt.cancel->load()) break;
-    while (bus.handleTimeout(0) > 0) {
+    while (wire::handle_timeout(bus, 0) > 0) {
     }
     const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     core.tick(now);
     if (opt.once && core.runs_served() > 0) break;
-    if (!core.step(now)) bus.handleTimeout(50);
+    if (!core.step(now)) wire::handle_timeout(bus, 50);
   }
   if (opt.core.log && core.unauthenticated() > 0)
     opt.core.log("dropped " + std::to_string(core.unauthenticated()) +

@@ -1,0 +1,115 @@
+#!/usr/bin/env bash
+# examples/slurm/ on a real one-node Slurm cluster that this script starts for itself: munged,
+# slurmctld and slurmd (Debian's munge and slurm-wlm) on loopback inside a private network
+# namespace, with a generated slurm.conf, all state in a temporary folder. Run by CTest:
+#   slurm_cluster.sh DICESIM_BINARY SHARDS TOSSES
+# The example's job array of SHARDS shards and its merge step (afterok dependency) must give the
+# counts of one `dicesim toss` of all TOSSES paper tosses. Under CI=true, not being able to run fails.
+set -euo pipefail
+[ -n "${DICESIM_TRACE:-}" ] && set -x
+
+skip() {
+  if [ -n "${CI:-}" ]; then echo "FAIL: cannot run under CI=$CI: $1" >&2; exit 1; fi
+  echo "SKIP: $1"; exit 77
+}
+if [ "${DICESIM_NETNS:-}" != "1" ]; then
+  if [ "$(id -u)" -ne 0 ]; then skip "network namespaces and slurmd need root"; fi
+  unshare --net true 2> /dev/null || skip "cannot make a network namespace here (unshare --net failed)"
+  exec unshare --net env DICESIM_NETNS=1 "$0" "$@"
+fi
+bin=$(readlink -f "$1") shards=$2 tosses=$3
+for p in munged mungekey slurmctld slurmd sbatch squeue; do
+  command -v "$p" > /dev/null || skip "no $p (Debian packages slurm-wlm and munge)"
+done
+ip link set lo up
+# Slurm binds its ports through getaddrinfo(AI_ADDRCONFIG), which finds no address family when the
+# only interface is loopback: a veth pair with both ends in this namespace (nothing can leave) gives it one.
+ip link add dicesim0 type veth peer name dicesim1
+ip addr add 10.255.255.1/32 dev dicesim0
+ip link set dicesim0 up
+ip link set dicesim1 up
+
+src_dir=$(cd "$(dirname "$0")/../.." && pwd)
+cd "$src_dir"
+work=$(mktemp -d "/tmp/dicesim-slurm-XXXXXX")
+chmod 755 "$work"
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  sleep 1
+  for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  [ -n "${DICESIM_KEEP:-}" ] || rm -rf "$work"
+}
+trap cleanup EXIT
+fail() { echo "FAIL [slurm]: $*" >&2; for f in "$work"/*.log "$work"/parts/*.log; do [ -f "$f" ] && { echo "--- $f" >&2; tail -n 15 "$f" >&2; }; done; exit 1; }
+
+# munge: a fresh key, a socket of its own.
+mkdir -m 700 "$work/munge"
+mungekey -c -k "$work/munge/munge.key" 2> /dev/null || dd if=/dev/urandom of="$work/munge/munge.key" bs=1024 count=1 2> /dev/null
+chmod 400 "$work/munge/munge.key"
+munged --force --key-file="$work/munge/munge.key" --socket="$work/munge/munge.sock" \
+  --pid-file="$work/munge/munged.pid" --log-file="$work/munge.log" --seed-file="$work/munge/seed" ||
+  fail "munged did not start"
+pids+=("$(cat "$work/munge/munged.pid")")
+
+host=$(hostname -s)
+cpus=$(nproc)
+mkdir -p "$work/state" "$work/spool" "$work/parts"
+cat > "$work/slurm.conf" <<CONF
+ClusterName=dicesim-test
+SlurmctldHost=$host(127.0.0.1)
+SlurmctldPort=6817
+SlurmdPort=6818
+SlurmUser=root
+SlurmdUser=root
+AuthType=auth/munge
+AuthInfo=socket=$work/munge/munge.sock
+CredType=cred/munge
+StateSaveLocation=$work/state
+SlurmdSpoolDir=$work/spool
+SlurmctldPidFile=$work/slurmctld.pid
+SlurmdPidFile=$work/slurmd.pid
+SlurmctldLogFile=$work/slurmctld.log
+SlurmdLogFile=$work/slurmd.log
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+SchedulerType=sched/builtin
+SelectType=select/cons_tres
+SelectTypeParameters=CR_CPU
+ReturnToService=2
+MpiDefault=none
+MaxArraySize=1001
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus State=UNKNOWN
+PartitionName=debug Nodes=$host Default=YES MaxTime=INFINITE State=UP
+CONF
+export SLURM_CONF=$work/slurm.conf
+slurmctld -i -D > "$work/slurmctld.out.log" 2>&1 & pids+=($!)
+slurmd -D -N "$host" > "$work/slurmd.out.log" 2>&1 & pids+=($!)
+for ((t = 0; t < 300; t++)); do
+  sinfo -h -o '%T' 2> /dev/null | grep -qE '^idle' && break
+  sleep 0.2
+done
+sinfo -h -o '%T' | grep -qE '^idle' || fail "the node did not come up idle within 60 s: $(sinfo 2>&1)"
+
+# The reference, then the example exactly as a user submits it.
+"$bin" toss scenes/paper/die1.toml --tosses "$tosses" --seed 1 --threads 2 --json > "$work/ref.json"
+cd "$work/parts"
+merge_job=$(DICESIM="$bin" "$src_dir/examples/slurm/submit.sh" "$src_dir/scenes/paper/die1.toml" "$tosses" "$shards" "$work/parts")
+echo "merge job $merge_job; waiting"
+for ((t = 0; t < 3000; t++)); do
+  [ -z "$(squeue -h 2> /dev/null)" ] && break
+  sleep 0.2
+done
+[ -z "$(squeue -h)" ] || fail "jobs still queued after 600 s: $(squeue)"
+[ "$(ls "$work/parts"/part-*.json | wc -l)" -eq "$shards" ] || fail "expected $shards part files: $(ls "$work/parts")"
+[ -s "$work/parts/run.json" ] || fail "the merge step wrote no run.json ($(cat "$work/parts"/dicesim-merge-*.log 2>&1))"
+stable() { sed -E 's/"scene":"[^"]*",?//; s/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//; s/"tosses_per_s":[^,}]*,?//' "$1"; }
+if [ "$(stable "$work/ref.json")" != "$(stable "$work/parts/run.json")" ]; then
+  echo "toss:  $(stable "$work/ref.json")" >&2
+  echo "slurm: $(stable "$work/parts/run.json")" >&2
+  fail "the merged Slurm array differs from dicesim toss"
+fi
+echo "PASS [slurm]: $shards shards of $tosses tosses merged to toss's counts"
