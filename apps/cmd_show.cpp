@@ -8,6 +8,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/info_json.hpp"
+#include "sim/body/material_parts.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/scene/scene_error.hpp"
 #include "web/show_data.hpp"
@@ -48,7 +49,7 @@ int run_show(const ShowArgs& a) {
   nlohmann::json page;
   page["scene"] = a.scene.path;
   page["die"] = web::die_json(m, def);
-  page["info"] = info_json(a.scene.path, m);
+  page["info"] = info_json(a.scene.path, m, material_parts(def, a.scene.path));
   if (with_toss) page["toss"] = web::toss_json(m, a.seed, static_cast<std::uint64_t>(a.toss));
   const std::string html = web::show_html(page);
   if (out == "-") {

@@ -5,6 +5,7 @@
 
 #include "apps/info_json.hpp"
 #include "python/bindings.hpp"
+#include "sim/body/material_parts.hpp"
 #include "web/show_data.hpp"
 #include "web/show_page.hpp"
 
@@ -34,7 +35,7 @@ ShowPage show(Scene& scene, std::optional<std::uint64_t> toss, std::uint64_t see
   nlohmann::json page;
   page["scene"] = scene.origin();
   page["die"] = web::die_json(*model, scene.def());
-  page["info"] = info_json(scene.origin(), *model);
+  page["info"] = info_json(scene.origin(), *model, material_parts(scene.def(), scene.origin()));
   if (toss) {
     pb::gil_scoped_release nogil;
     page["toss"] = web::toss_json(*model, seed, *toss);

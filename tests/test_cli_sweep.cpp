@@ -89,7 +89,7 @@ TEST(CliSweep, EveryPointReportsItsCorrectionsAsTossDoes) {
   EXPECT_EQ(table.out.find("point 0.5: corrections: ") != std::string::npos, any) << table.out;
   EXPECT_EQ(table.out.find("whole sweep: corrections: ") != std::string::npos, any) << table.out;
   expect_bad_input(cli("sweep scenes/coins/quarter-table.toml --param floor.restitution --values 0.5 --fidelity fast"),
-                   {"sim.fidelity", "fast"});
+                   {"--fidelity", "'fast' is not a fidelity"});  // refused before any scene is read
 }
 
 TEST(CliSweep, CsvColumnsAndVectorTemplate) {

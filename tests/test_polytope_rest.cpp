@@ -109,7 +109,8 @@ TEST(PolytopeRest, RegularSolidsStayOnTheirFace) {
 }
 
 TEST(PolytopeRest, PrismAndIrregularHullStayOnTheirFace) {
-  check_rest_soundness({"prism", hull_body(prism(3, 0.006, 0.04), 1200.0, "prism")}, 1000);
+  // Read from the face it rests on, as scenes/dice/prism3.toml: lying on a side it has an edge on top.
+  check_rest_soundness({"prism", read_down(hull_body(prism(3, 0.006, 0.04), 1200.0, "prism"))}, 1000);
   check_rest_soundness({"irregular", hull_body(irregular())}, 1000);
 }
 
