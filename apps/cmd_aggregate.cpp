@@ -16,6 +16,7 @@
 #include "aggregator/session.hpp"
 #include "aggregator/target.hpp"
 #include "apps/commands.hpp"
+#include "sim/scene/scene_hash.hpp"
 #include "apps/fidelity_name.hpp"
 #include "apps/progress.hpp"
 #include "apps/report.hpp"
@@ -225,7 +226,14 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
                            static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
   }
   r.elapsed_s = res.run_elapsed_s;
-  r.provenance = make_provenance(spec.origin, spec.overrides, wire::spec_scene_sha256(spec), model, spec.seed, spec.total, r.threads);
+  // The user's scene and overrides, as `toss` reports them: auto's choice travels to the workers as
+  // one more override (prepare_run), which is how the run was made, not what was asked. A resumed
+  // run has only the checkpoint's spec.
+  if (resume)
+    r.provenance = make_provenance(spec.origin, spec.overrides, wire::spec_scene_sha256(spec), model, spec.seed, spec.total, r.threads);
+  else
+    r.provenance = make_provenance(a.scene.path, a.scene.applied_overrides(), scene_sha256(a.scene.path, a.scene.applied_overrides()),
+                                   model, spec.seed, spec.total, r.threads);
   print_report(r, a.json);
   return kExitOk;
 }
