@@ -1,4 +1,5 @@
 #include "apps/shard_file.hpp"
+#include <algorithm>
 
 #include <cstdio>
 #include <fstream>
@@ -115,6 +116,27 @@ ShardPart read_shard_file(const std::string& file) {
     r.faces_per_label = s.at("faces_per_label").get<std::vector<int>>();
     r.names = s.at("names").get<std::vector<std::string>>();
     r.counts = counts_from(s.at("counts"));
+    r.fidelity_requested = j.value("fidelity_requested", std::string());
+    r.fidelity_reason = j.value("fidelity_reason", std::string());
+    // The outcomes alike by design, as the toss's report found them from its model (merge has none):
+    // groups of labels back to each outcome's first alike outcome (report.hpp, RunReport::alike).
+    if (j.contains("alike") && j.at("alike").is_object()) {
+      const auto& a = j.at("alike");
+      r.alike.resize(r.labels.size());
+      for (std::size_t i = 0; i < r.alike.size(); ++i) r.alike[i] = static_cast<int>(i);
+      for (const auto& g : a.at("groups")) {
+        int first = -1;
+        for (const auto& label : g) {
+          const auto at = std::find(r.labels.begin(), r.labels.end(), label.get<int>());
+          if (at == r.labels.end()) throw ShardError(file + ": an alike group names label " + label.dump() + ", not an outcome");
+          const int k = static_cast<int>(at - r.labels.begin());
+          if (first < 0) first = k;
+          r.alike[static_cast<std::size_t>(k)] = first;
+        }
+      }
+      r.symmetry_rotations = a.at("rotations").get<int>();
+      r.alike_note = a.at("note").get<std::string>();
+    }
     // prov's provenance (apps/provenance.hpp), when the toss wrote one: the merged report carries it,
     // and its version (git describe) and resolved-scene SHA-256 must agree across shards too.
     if (j.contains("provenance")) {

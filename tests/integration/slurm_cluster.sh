@@ -106,7 +106,7 @@ done
 [ -z "$(squeue -h)" ] || fail "jobs still queued after 600 s: $(squeue)"
 [ "$(ls "$work/parts"/part-*.json | wc -l)" -eq "$shards" ] || fail "expected $shards part files: $(ls "$work/parts")"
 [ -s "$work/parts/run.json" ] || fail "the merge step wrote no run.json ($(cat "$work/parts"/dicesim-merge-*.log 2>&1))"
-stable() { sed -E 's/"scene":"[^"]*",?//; s/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//; s/"tosses_per_s":[^,}]*,?//' "$1"; }
+stable() { sed -E 's/"scene":"[^"]*",?//g; s/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//g; s/"tosses_per_s":[^,}]*,?//; s/"seconds":[^,}]*,?//g' "$1"; }  # threads: also provenance's
 if [ "$(stable "$work/ref.json")" != "$(stable "$work/parts/run.json")" ]; then
   echo "toss:  $(stable "$work/ref.json")" >&2
   echo "slurm: $(stable "$work/parts/run.json")" >&2

@@ -54,7 +54,7 @@ n=20000
 echo "scenario $scenario over $LCM_DEFAULT_URL"
 
 fail() { echo "FAIL [$scenario]: $*" >&2; for f in "$work"/*.err; do echo "--- $f" >&2; tail -n 20 "$f" >&2; done; exit 1; }
-stable() { sed -E 's/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//; s/"tosses_per_s":[^,}]*,?//' "$1"; }
+stable() { sed -E 's/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//g; s/"tosses_per_s":[^,}]*,?//; s/"seconds":[^,}]*,?//g' "$1"; }  # threads: also provenance's; seconds: auto's pilot time
 reference() { "$bin" toss "$scene" --tosses "$n" --seed "$seed" --threads 2 --json > "$work/ref.json"; }
 same_as_reference() {
   [ -s "$1" ] || fail "no JSON from the distributed run"
