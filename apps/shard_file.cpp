@@ -28,11 +28,10 @@ RunCounts counts_from(const nlohmann::json& j) {
   c.unresolved = j.at("unresolved").get<std::uint64_t>();
   c.invalid = j.at("invalid").get<std::uint64_t>();
   c.bounces = j.at("bounces").get<std::uint64_t>();
+  // Every kind, by the names corrections_json writes (the first four alone dropped the sustained
+  // phase's guards from a merged report).
   const auto& k = j.at("corrections");
-  c.corrections.energy_clamps = k.at("energy_clamps").get<std::uint64_t>();
-  c.corrections.pgs_unconverged = k.at("pgs_unconverged").get<std::uint64_t>();
-  c.corrections.overlap_fixes = k.at("overlap_fixes").get<std::uint64_t>();
-  c.corrections.fallbacks = k.at("fallbacks").get<std::uint64_t>();
+  c.corrections.for_each([&](const char* name, std::uint64_t& n) { n = k.at(name).get<std::uint64_t>(); });
   return c;
 }
 

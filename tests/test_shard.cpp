@@ -108,6 +108,22 @@ TEST(CliShard, FourShardsMergeToOneTossOfTheWholeRange) {
   EXPECT_NE(table.out.find("face       count"), std::string::npos);
 }
 
+TEST(CliShard, MergedCorrectionsAreEveryKindTossCounts) {
+  // A d20 in impulse fires the sustained phase's guards (located_capped ~1 in 100 tosses): merge
+  // must add every kind, not only the first four.
+  const std::string base = "toss scenes/dice/d20.toml --fidelity impulse -n 2000 --seed 3 --json";
+  const CliRun whole = run_dicesim(base);
+  ASSERT_EQ(whole.code, 0) << whole.err;
+  const std::string a = unique_temp("d20-0.json"), b = unique_temp("d20-1.json");
+  ASSERT_EQ(run_dicesim(base + " --shard 0/2 --out " + a).code, 0);
+  ASSERT_EQ(run_dicesim(base + " --shard 1/2 --out " + b).code, 0);
+  const CliRun merged = run_dicesim("merge --json " + a + " " + b);
+  ASSERT_EQ(merged.code, 0) << merged.err;
+  const auto w = nlohmann::json::parse(whole.out), m = nlohmann::json::parse(merged.out);
+  ASSERT_GT(w["corrections"]["located_capped"].get<long long>(), 0) << w["corrections"];
+  EXPECT_EQ(m["corrections"], w["corrections"]);
+}
+
 TEST(CliShard, MergeRefusesShardsOfOtherRunsNamingTheFile) {
   const Parts& p = parts();
   // A missing shard.
