@@ -112,6 +112,11 @@ TEST(Equivalence, RelativeMarginOnARareOutcome) {
   EXPECT_FALSE(e.equivalent);
   EXPECT_FALSE(e.outcomes[2].equivalent);
   EXPECT_NEAR(e.outcomes[2].margin, 0.2 * 2300.0 / 200'000.0, 1e-15);
+  // An edge neither run saw (a small run): equivalent, though its relative margin is 0.
+  const Equivalence none = equivalence_unpaired({500, 500, 0}, {510, 490, 0}, relative_margin(0.2));
+  EXPECT_TRUE(none.outcomes[2].equivalent);
+  EXPECT_EQ(none.outcomes[2].margin, 0.0);
+  EXPECT_TRUE(none.equivalent);  // heads and tails within 20 % of 0.5: z = 4.1 and 5.0 at 1000 tosses
 }
 
 TEST(Equivalence, BadInputThrows) {

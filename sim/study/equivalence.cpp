@@ -19,6 +19,15 @@ void check_alpha(double alpha) {
     throw std::invalid_argument("equivalence: alpha " + std::to_string(alpha) + " is outside (0, 0.5)");
 }
 
+// An outcome neither run ever gave: no difference and no variance, equivalent at any margin (a
+// relative margin is then 0 itself).
+OutcomeEquivalence unseen(double margin) {
+  OutcomeEquivalence o;
+  o.margin = margin;
+  o.p_lower = o.p_upper = o.tost_p = 0.0;
+  return o;
+}
+
 // Fills the per-outcome tests from diff and se, and the Holm verdict.
 Equivalence finish(std::vector<OutcomeEquivalence> o, double alpha, bool paired) {
   Equivalence e;
@@ -86,7 +95,7 @@ Equivalence equivalence_unpaired(const std::vector<std::uint64_t>& a, const std:
     const double pb = static_cast<double>(b[i]) / static_cast<double>(nb);
     const double pooled = static_cast<double>(a[i] + b[i]) / static_cast<double>(na + nb);
     const double se = std::sqrt(pa * (1.0 - pa) / static_cast<double>(na) + pb * (1.0 - pb) / static_cast<double>(nb));
-    OutcomeEquivalence o = tost(pa - pb, se, margin(pooled), alpha);
+    OutcomeEquivalence o = a[i] + b[i] == 0 ? unseen(margin(0.0)) : tost(pa - pb, se, margin(pooled), alpha);
     o.p_a = pa;
     o.p_b = pb;
     out.push_back(o);
@@ -113,7 +122,8 @@ Equivalence equivalence_paired(const std::vector<std::uint64_t>& a, const std::v
     const double pa = static_cast<double>(a[i]) / dn, pb = static_cast<double>(b[i]) / dn;
     const double d = pa - pb;
     const double var = std::max(0.0, static_cast<double>(a_only[i] + b_only[i]) / dn - d * d);
-    OutcomeEquivalence o = tost(d, std::sqrt(var / dn), margin(0.5 * (pa + pb)), alpha);
+    OutcomeEquivalence o =
+        a[i] + b[i] == 0 ? unseen(margin(0.0)) : tost(d, std::sqrt(var / dn), margin(0.5 * (pa + pb)), alpha);
     o.p_a = pa;
     o.p_b = pb;
     out.push_back(o);
