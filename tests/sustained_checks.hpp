@@ -1,0 +1,198 @@
+// Deterministic checks of the sustained-contact phase against closed-form mechanics (issue 39,
+// point 2): a block sliding to rest, Euler's disk in steady precession, a die rocking about a
+// sticking edge onto its face. Each returns the measured error for one integrator setting, so that
+// any sustained-contact integrator can be measured the same way: pass a factory that builds its
+// step function for a die (fixed_steps() wraps today's FixedStepper as `impulse` and `stepped` use
+// it). tests/test_sustained_checks.cpp asserts the tolerances and prints the error-vs-step tables.
+#pragma once
+
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "scenes_for_tests.hpp"
+#include "sim/body/die_model.hpp"
+#include "sim/dynamics/contact.hpp"
+#include "sim/dynamics/contact_stepper.hpp"
+#include "sim/models/compile.hpp"
+#include "sim/scene/scene.hpp"
+
+namespace dicesim::testing {
+
+// One step of a sustained-contact integrator: advances s, returns the time it advanced (s).
+using SustainedStep = std::function<double(RigidState&)>;
+// Builds a fresh integrator (its own state) for a die.
+using SustainedFactory = std::function<SustainedStep(const DieModel&)>;
+
+// Today's FixedStepper with step h (<= 0: the die's contact_step). impulse = true: as `impulse`'s
+// sustained phase runs it (gravity threshold, held corners sinking at most held_corner_sink);
+// false: as `stepped` runs it (contact threshold, no sink bound).
+inline SustainedFactory fixed_steps(double h, bool impulse = true) {
+  return [h, impulse](const DieModel& m) -> SustainedStep {
+    const double step = h > 0.0 ? h : m.contact_step;
+    auto st = impulse ? std::make_shared<FixedStepper>(m, step, ImpactThreshold::Gravity, held_corner_sink(m))
+                      : std::make_shared<FixedStepper>(m, step, ImpactThreshold::Contact);
+    return [st](RigidState& s) {
+      st->step(s);
+      return st->last_dt();
+    };
+  };
+}
+
+// The height of s's lowest contact point relative to its COM (< 0).
+inline double lowest_offset(const DieModel& m, const Mat3& R) {
+  double low = 0.0;
+  for (int i = 0; i < m.vertex_count(); ++i) low = std::min(low, contact_point(m, R, i).z());
+  return low;
+}
+
+struct CheckResult {
+  double measured = 0.0;
+  double expected = 0.0;
+  double rel_error = 0.0;  // (measured - expected) / expected
+  long steps = 0;
+};
+
+// a. A 3 cm cube (fair_scene, friction mu) lying flat on its -z face, sliding along x at v with no
+// spin: Coulomb friction decelerates it at mu g, so it stops after v^2 / (2 mu g). measured: the
+// distance its COM travelled until it stopped (speed below 1e-9 v).
+inline CheckResult sliding_block(const SustainedFactory& make, double v = 1.0, double mu = 0.3) {
+  SceneDef def = fair_scene();
+  def.materials["plastic"].friction = mu;
+  const DieModel m = compile(def);
+  RigidState s;
+  s.R = m.geo_to_body.transpose();
+  s.position = Vec3(0.0, 0.0, -lowest_offset(m, s.R));
+  s.velocity = Vec3(v, 0.0, 0.0);
+  const Vec3 start = s.position;
+  SustainedStep step = make(m);
+  CheckResult r;
+  r.expected = v * v / (2.0 * mu * m.gravity);
+  const double t_stop = v / (mu * m.gravity);
+  double t = 0.0;
+  while (t < 3.0 * t_stop && s.velocity.norm() + s.omega.norm() * m.bounding_radius > 1e-9 * v) {
+    t += step(s);
+    ++r.steps;
+  }
+  r.measured = (s.position - start).head<2>().norm();
+  r.rel_error = (r.measured - r.expected) / r.expected;
+  return r;
+}
+
+// b. Euler's disk: the quarter (scenes/coins/quarter.toml: a cylinder 24.26 mm across, 1.75 mm
+// thick, rims rounded 0.2 mm) with high friction and no rolling or pivoting resistance, rolling
+// without slipping with its centre at rest, its axis n at angle alpha from the vertical (the
+// face alpha from the floor), n precessing about the vertical at Omega.
+// Steady motion (world frame, n = (sin a, 0, cos a) at t = 0, the contact point P at r = P - COM,
+// fixed in the frame turning at Omega e_z):
+//  - the centre at rest and no slip at P: v_P = omega x r = 0, so omega = lambda r; with
+//    omega = Omega e_z + s n (precession and spin) this fixes omega = Omega w~ (w~ in the x-z plane,
+//    linear in r: its x and z components solve s n_x = lambda r_x, 1 + s n_z = lambda r_z);
+//  - the COM at rest: the floor's force is m g e_z (no friction);
+//  - L = I_world omega = Omega L~ turns with the frame: dL/dt = Omega^2 e_z x L~ = r x m g e_z.
+//  Its y component: Omega^2 = m g (r x e_z)_y / (e_z x L~)_y. (A thin disk of radius a, r = a u,
+//  I = m a^2 / 4 about a diameter: Omega^2 = 4 g / (a sin alpha), the textbook result.)
+// r: the lower rim's lowest point, a' u - h' n - rho e_z (u = (cos a, 0, -sin a) down the face,
+// a' and h' the core's radius and half-height, rho the rounding).
+// (tests/test_cylinder.cpp's EulersDiskPrecessesAtTheSteadyRate puts the contact at the corner of
+// the cylinder enlarged by the rounding; here it is the rounded rim's lowest point, the model's.)
+// measured: the azimuth of n advanced over `duration` (default 0.5 s, 6.5 turns at 30 deg: the
+// steady motion must be kept, not only started) divided by the time (unwrapped).
+inline CheckResult euler_disk(const SustainedFactory& make, double alpha = 30.0 * kPi / 180.0,
+                              double duration = 0.5) {
+  SceneDef def = load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter.toml");
+  for (auto& [name, mat] : def.materials) {
+    mat.friction = 2.0;
+    mat.rolling_resistance = 0.0;
+    mat.pivoting_resistance = 0.0;
+  }
+  const DieModel m = compile(def);
+  const Vec3 n(std::sin(alpha), 0.0, std::cos(alpha));
+  const Vec3 u(std::cos(alpha), 0.0, -std::sin(alpha));
+  const Vec3 ez = Vec3::UnitZ();
+  RigidState s;
+  s.R = Quat::FromTwoVectors(m.rims.axis, n).toRotationMatrix();
+  const Vec3 r = s.R * m.rims.centre + m.rims.radius * u - m.rims.half * n - m.rounding * ez;
+  const double lambda = 1.0 / (r.z() - r.x() * n.z() / n.x());
+  const Vec3 w = lambda * r;  // for Omega = 1
+  const Mat3 I = s.R * m.principal_moments.asDiagonal() * s.R.transpose();
+  const Vec3 L = I * w;
+  const double omega2 = m.mass * m.gravity * r.cross(ez).y() / ez.cross(L).y();
+  CheckResult res;
+  res.expected = std::sqrt(omega2);
+  s.position = Vec3(0.0, 0.0, -r.z());
+  s.omega = res.expected * w;
+  // The model's own lowest point must be the one the derivation holds (not the other rim).
+  if (std::abs(lowest_offset(m, s.R) - r.z()) > 1e-12) return {0.0, res.expected, 1.0, 0};
+  SustainedStep step = make(m);
+  double t = 0.0, phi = 0.0;
+  Vec3 prev = n;
+  while (t < duration) {
+    t += step(s);
+    ++res.steps;
+    const Vec3 a = s.R * m.rims.axis;
+    phi += std::atan2(prev.x() * a.y() - prev.y() * a.x(), prev.x() * a.x() + prev.y() * a.y());
+    prev = a;
+  }
+  res.measured = phi / t;
+  res.rel_error = (res.measured - res.expected) / res.expected;
+  return res;
+}
+
+// c. A 3 cm cube (fair_scene, friction mu: the edge sticks) balanced on an edge of its -z face and
+// tipped back by theta0 toward that face, released at rest: it turns about the edge and lands on
+// the face. Energy (no slip, no loss before the landing): omega^2 = 2 m g (h_start - h_land) / I_edge,
+// I_edge the moment about the edge (I_com about its direction + m d^2). measured: |omega| of the
+// last state before the landing impact (the step after which |omega| drops by more than half);
+// the test checks that state's face is within 1e-3 rad of flat.
+struct RockingResult : CheckResult {
+  double tilt_at_landing = 0.0;  // angle of the landing face to the floor in that state (rad)
+};
+inline RockingResult rocking_die(const SustainedFactory& make, double theta0 = 0.1, double mu = 1.0) {
+  SceneDef def = fair_scene();
+  def.materials["plastic"].friction = mu;
+  def.materials["plastic"].restitution = 0.0;  // the landing stops it (|omega| drops to ~0)
+  const DieModel m = compile(def);
+  const double beta = 0.25 * kPi - theta0;
+  RigidState s;
+  s.R = Eigen::AngleAxisd(beta, Vec3::UnitX()).toRotationMatrix() * m.geo_to_body.transpose();
+  s.position = Vec3(0.0, 0.0, -lowest_offset(m, s.R));
+  // The edge: the -z face's corners with geometric y = -edge/2 (the two lowest); its direction x.
+  const Vec3 face_n = m.geo_to_body * Vec3(0.0, 0.0, -1.0);  // the landing face's normal, body frame
+  Vec3 edge_point = Vec3::Zero();
+  int on_edge = 0;
+  for (int i = 0; i < m.vertex_count(); ++i) {
+    const Vec3 p = contact_point(m, s.R, i);
+    if (p.z() < lowest_offset(m, s.R) + 1e-12) {
+      edge_point += p;
+      ++on_edge;
+    }
+  }
+  edge_point /= on_edge;
+  const Vec3 e = Vec3::UnitX();
+  const Vec3 d = -edge_point - (-edge_point).dot(e) * e;  // COM relative to the edge, perpendicular
+  const Mat3 I = s.R * m.principal_moments.asDiagonal() * s.R.transpose();
+  const double I_edge = e.dot(I * e) + m.mass * d.squaredNorm();
+  const int landing_face = 5;  // -z in the shape's face order (+x, -x, +y, -y, +z, -z)
+  const double h_start = s.position.z(), h_land = m.face_height[landing_face];
+  RockingResult res;
+  res.expected = std::sqrt(2.0 * m.mass * m.gravity * (h_start - h_land) / I_edge);
+  SustainedStep step = make(m);
+  double t = 0.0;
+  while (t < 2.0) {
+    const RigidState before = s;
+    t += step(s);
+    ++res.steps;
+    if (s.omega.norm() < 0.5 * before.omega.norm() && before.omega.norm() > 0.5 * res.expected) {
+      res.measured = before.omega.norm();
+      res.tilt_at_landing = std::acos(std::min(1.0, -(before.R * face_n).z()));
+      break;
+    }
+  }
+  res.rel_error = (res.measured - res.expected) / res.expected;
+  if (on_edge != 2) res.rel_error = 1.0;  // not the edge balance the check means
+  return res;
+}
+
+}  // namespace dicesim::testing

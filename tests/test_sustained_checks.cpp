@@ -1,0 +1,100 @@
+// Deterministic checks of the sustained-contact phase against closed-form mechanics
+// (tests/sustained_checks.hpp, issue 39 point 2). The tolerances are the issue's: a sliding block
+// stops at v^2 / (2 mu g) within 0.5 %, Euler's disk precesses at the steady rate within 0.3 %; a
+// die rocking about a sticking edge lands with the speed energy gives within 0.25 % (0.5 % of its
+// kinetic energy, the sliding block's tolerance on an energy-derived length). Today's first-order
+// FixedStepper meets none of them at its default contact step (3 ms polyhedra, 1 ms cylinders):
+// those assertions are the DISABLED_ tests, for the error-controlled integrator to enable; the
+// enabled ones hold the same tolerances at the finer step where today's stepper meets them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "sustained_checks.hpp"
+
+using namespace dicesim;
+using namespace dicesim::testing;
+
+namespace {
+
+constexpr double kDefault = 0.0;  // fixed_steps(0): the die's own contact_step
+
+// Prints one check's relative error against the step with the observed order between successive
+// steps, and returns the errors (coarsest first).
+template <class F>
+std::vector<double> table(const char* what, F check) {
+  const std::vector<double> steps = {3e-3, 1e-3, 3e-4, 1e-4};
+  std::printf("%s, FixedStepper as `impulse` runs it\n  step (ms)   measured      expected      rel. error    order   steps\n",
+              what);
+  std::vector<double> errors;
+  double prev = 0.0, prev_h = 0.0;
+  for (double h : steps) {
+    const CheckResult r = check(fixed_steps(h));
+    const double order =
+        prev != 0.0 && r.rel_error != 0.0 ? std::log(std::abs(prev / r.rel_error)) / std::log(prev_h / h) : NAN;
+    std::printf("  %8.2f  %12.7g  %12.7g  %+11.3e  %6.2f  %6ld\n", h * 1e3, r.measured, r.expected, r.rel_error, order,
+                r.steps);
+    errors.push_back(r.rel_error);
+    prev = r.rel_error;
+    prev_h = h;
+  }
+  return errors;
+}
+
+}  // namespace
+
+// The error-vs-step tables (the report's main result; run with --gtest_filter=SustainedChecks.Tables
+// to read them). Each check must converge: 30x finer steps at least 10x smaller error.
+TEST(SustainedChecks, Tables) {
+  const auto slide = table("sliding block (3 cm cube, v 1 m/s, mu 0.3): stop distance (m)",
+                           [](const SustainedFactory& f) { return sliding_block(f); });
+  const auto disk = table("Euler's disk (quarter, alpha 30 deg, 0.5 s): precession rate (rad/s)",
+                          [](const SustainedFactory& f) { return euler_disk(f); });
+  const auto rock = table("rocking die (3 cm cube, theta0 0.1 rad, mu 1): landing |omega| (rad/s)",
+                          [](const SustainedFactory& f) { return static_cast<CheckResult>(rocking_die(f)); });
+  for (const auto* e : {&slide, &disk, &rock}) EXPECT_LT(std::abs(e->back()), 0.1 * std::abs(e->front()));
+}
+
+// The stepper's error here is -mu g h / v to first order (each step removes mu g h of speed, and
+// the position moves with the step's end speed: the distance is short by v h / 2): 3 ms gives
+// -0.88 %, 1 ms -0.29 %.
+TEST(SustainedChecks, SlidingBlockStopsAtTheCoulombDistance) {
+  const CheckResult r = sliding_block(fixed_steps(1e-3));
+  EXPECT_LT(std::abs(r.rel_error), 0.005) << r.measured << " m against " << r.expected;
+}
+TEST(SustainedChecks, DISABLED_SlidingBlockAtTheDefaultStep) {  // today -0.88 % at 3 ms
+  const CheckResult r = sliding_block(fixed_steps(kDefault));
+  EXPECT_LT(std::abs(r.rel_error), 0.005) << r.measured << " m against " << r.expected;
+}
+
+// Today -0.12 % at 0.1 ms (30 deg), -1.2 % at the default 1 ms (the mean rate falls as the
+// motion decays, so the error grows with the time measured: over the first 0.1 s it is -0.25 %
+// at 1 ms); at 20 and 60 deg -0.12 % and -0.09 % at 0.1 ms (not run here: 2 s each).
+TEST(SustainedChecks, EulersDiskPrecessesAtTheSteadyRate) {
+  const CheckResult r = euler_disk(fixed_steps(1e-4));
+  EXPECT_LT(std::abs(r.rel_error), 0.003) << r.measured << " rad/s against " << r.expected;
+}
+TEST(SustainedChecks, DISABLED_EulersDiskAtTheDefaultStep) {
+  for (double alpha_deg : {20.0, 30.0, 60.0}) {
+    const CheckResult r = euler_disk(fixed_steps(kDefault), alpha_deg * kPi / 180.0);
+    EXPECT_LT(std::abs(r.rel_error), 0.003) << alpha_deg << " deg: " << r.measured << " rad/s against " << r.expected;
+  }
+}
+
+// Today -0.08 % at 0.1 ms (theta0 0.1 rad; -0.18 % from 0.02 rad), -2.7 % at the default 3 ms.
+TEST(SustainedChecks, RockingDieLandsWithTheSpeedEnergyGives) {
+  for (double theta0 : {0.02, 0.1, 0.3}) {
+    const RockingResult r = rocking_die(fixed_steps(1e-4), theta0);
+    EXPECT_LT(std::abs(r.rel_error), 0.0025) << theta0 << " rad: " << r.measured << " rad/s against " << r.expected;
+    EXPECT_LT(r.tilt_at_landing, 1e-3) << theta0;  // measured at the landing, not before it
+  }
+}
+TEST(SustainedChecks, DISABLED_RockingDieAtTheDefaultStep) {
+  for (double theta0 : {0.02, 0.1, 0.3}) {
+    const RockingResult r = rocking_die(fixed_steps(kDefault), theta0);
+    EXPECT_LT(std::abs(r.rel_error), 0.0025) << theta0 << " rad: " << r.measured << " rad/s against " << r.expected;
+    EXPECT_LT(r.tilt_at_landing, 1e-3) << theta0;
+  }
+}
