@@ -1,8 +1,11 @@
 // dicesim toss: Monte Carlo probabilities of each face, in this process.
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "aggregator/target.hpp"
 #include "apps/commands.hpp"
@@ -29,7 +32,16 @@ struct TossArgs {
   CLI::Option* tosses_opt = nullptr;
   std::string shard;  // --shard I/N
   std::string out;    // --out FILE: the shard file for `dicesim merge`
+  std::string outcomes;  // --outcomes FILE: each toss's outcome label (paired `compare`)
 };
+
+// Each toss's outcome label, one line per toss index (sim/study/compare.hpp's read_toss_outcomes).
+bool write_outcomes(std::ofstream& f, const DieModel& m, const TossArgs& a, const std::vector<std::int16_t>& o) {
+  f << "# dicesim toss --outcomes: " << a.scene.path << ", fidelity " << to_string(m.fidelity) << ", seed " << a.seed
+    << ", tosses 0.." << o.size() << " (one line per toss index: its outcome label, -1 if it did not settle)\n";
+  for (const std::int16_t i : o) f << (i < 0 ? -1 : m.outcome_labels[static_cast<std::size_t>(i)]) << '\n';
+  return static_cast<bool>(f.flush());
+}
 
 int run_toss(const TossArgs& a) {
   const SceneDef def = a.scene.load();
@@ -50,6 +62,18 @@ int run_toss(const TossArgs& a) {
   if ((!a.shard.empty() || !a.out.empty()) && a.target_halfwidth > 0.0) {
     std::fprintf(stderr, "dicesim: error: --shard/--out and --target-halfwidth exclude each other (a shard tosses a fixed block)\n");
     return kExitBadInput;
+  }
+  if (!a.outcomes.empty() && (!a.shard.empty() || a.target_halfwidth > 0.0)) {
+    std::fprintf(stderr, "dicesim: error: --outcomes excludes --shard and --target-halfwidth (it records tosses 0..N-1)\n");
+    return kExitBadInput;
+  }
+  std::ofstream outcomes_file;  // opened now: a path that cannot be written is bad input, not a lost run
+  if (!a.outcomes.empty()) {
+    outcomes_file.open(a.outcomes);
+    if (!outcomes_file) {
+      std::fprintf(stderr, "dicesim: error: --outcomes %s: cannot write it\n", a.outcomes.c_str());
+      return kExitBadInput;
+    }
   }
   std::ofstream out_file;
   if (!a.out.empty()) {
@@ -74,6 +98,8 @@ int run_toss(const TossArgs& a) {
   cfg.tosses = block.tosses;
   cfg.threads = a.threads;
   cfg.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
+  std::vector<std::int16_t> outcomes;
+  if (!a.outcomes.empty()) cfg.outcomes = &outcomes;
 
   const auto t0 = std::chrono::steady_clock::now();
   std::uint64_t tosses = block.tosses;
@@ -111,6 +137,10 @@ int run_toss(const TossArgs& a) {
       std::fprintf(stderr, "dicesim: failed: cannot write --out %s\n", a.out.c_str());
       return kExitFailed;
     }
+  }
+  if (!a.outcomes.empty() && !partial && !write_outcomes(outcomes_file, model, a, outcomes)) {
+    std::fprintf(stderr, "dicesim: failed: cannot write --outcomes %s\n", a.outcomes.c_str());
+    return kExitFailed;
   }
   print_report(r, a.json);
   if (partial) std::fprintf(stderr, "dicesim: interrupted after %llu of %llu tosses\n", static_cast<unsigned long long>(tosses),
@@ -166,6 +196,10 @@ void register_toss(CLI::App& app, int& exit_code) {
   cmd->add_option("--out", args->out,
                   "Also write the report as a shard file for `dicesim merge` (the --json report plus a \"shard\"\n"
                   "object: version, scene hash, model fingerprint, block, raw counts); stdout is unchanged")
+      ->type_name("FILE");
+  cmd->add_option("--outcomes", args->outcomes,
+                  "Also write each toss's outcome label, one line per toss index (-1: not settled), for\n"
+                  "`dicesim compare A.json B.json --margin D --paired A.txt B.txt` on two runs with the same seed")
       ->type_name("FILE");
   cmd->add_flag("--json", args->json, "Print exactly one JSON object on stdout instead of the table");
   cmd->callback([args, &exit_code] { exit_code = run_toss(*args); });

@@ -89,3 +89,40 @@ TEST(CliCompareEquivalence, BadInput) {
 }
 
 }  // namespace
+
+namespace {
+
+// Two runs with the same seed (`impulse` at its default contact step and at 0.3 ms) paired by
+// toss index: few tosses change outcome, so the paired test is far narrower than the unpaired.
+TEST(CliCompareEquivalence, PairedByTossIndex) {
+  const std::string a = dicesim::testing::unique_temp("pa.json"), b = dicesim::testing::unique_temp("pb.json");
+  const std::string oa = dicesim::testing::unique_temp("pa.txt"), ob = dicesim::testing::unique_temp("pb.txt");
+  ASSERT_EQ(cli("toss scenes/fair.toml -n 3000 --seed 3 --json --outcomes " + oa + " > " + a).code, 0);
+  ASSERT_EQ(cli("toss scenes/fair.toml -n 3000 --seed 3 --json --set sim.contact_step=0.0003 --outcomes " + ob + " > " + b).code, 0);
+  const CliRun paired = cli("compare " + a + " " + b + " --margin 0.01 --paired " + oa + " " + ob + " --json");
+  ASSERT_EQ(paired.code, 0) << paired.err;
+  const auto p = nlohmann::json::parse(paired.out)["equivalence"];
+  EXPECT_EQ(p["paired"], true);
+  EXPECT_EQ(p["pairs"], 3000);
+  EXPECT_EQ(p["dropped"], 0);
+  const auto u = nlohmann::json::parse(cli("compare " + a + " " + b + " --margin 0.01 --json").out)["equivalence"];
+  EXPECT_EQ(u["paired"], false);
+  for (std::size_t f = 0; f < 6; ++f) {
+    EXPECT_DOUBLE_EQ(p["faces"][f]["diff"].get<double>(), u["faces"][f]["diff"].get<double>());
+    EXPECT_LT(p["faces"][f]["se"].get<double>(), 0.5 * u["faces"][f]["se"].get<double>()) << f;
+  }
+  EXPECT_EQ(p["equivalent"], true);
+  EXPECT_EQ(u["equivalent"], false);  // 3000 unpaired tosses cannot show 0.01 for six faces
+  const CliRun table = cli("compare " + a + " " + b + " --margin 0.01 --paired " + oa + " " + ob);
+  EXPECT_NE(table.out.find("paired by toss index over 3000 tosses"), std::string::npos) << table.out;
+  // Bad input: --paired without a margin, the files swapped (B's outcomes are not A's counts), a
+  // shard's outcomes.
+  expect_bad_input(cli("compare " + a + " " + b + " --paired " + oa + " " + ob), {"--paired", "--margin"});
+  const CliRun swapped = cli("compare " + a + " " + b + " --margin 0.01 --paired " + ob + " " + oa);
+  expect_bad_input(swapped, {"must equal A's count"});  // the two runs' counts differ (checked: 499 / 500 on face 1)
+  expect_bad_input(cli("toss scenes/fair.toml -n 100 --shard 0/2 --outcomes " + oa), {"--outcomes", "--shard"});
+  std::ofstream(oa) << "1\n2\nseven\n";
+  expect_bad_input(cli("compare " + a + " " + b + " --margin 0.01 --paired " + oa + " " + ob), {"line 3", "'seven'"});
+}
+
+}  // namespace

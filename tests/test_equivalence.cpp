@@ -4,7 +4,10 @@
 #include <stdexcept>
 #include <vector>
 
+#include "scenes_for_tests.hpp"
+#include "sim/models/compile.hpp"
 #include "sim/study/equivalence.hpp"
+#include "sim/study/monte_carlo.hpp"
 
 namespace dicesim {
 namespace {
@@ -103,6 +106,20 @@ TEST(Equivalence, PairedTossesUseTheDiscordantCounts) {
   EXPECT_THROW(equivalence_paired(a2, b, moved, moved, absolute_margin(0.002)), std::invalid_argument);
 }
 
+TEST(Equivalence, PairedCountsFromPerTossOutcomes) {
+  // Toss 0: both 0; 1: 0 -> 1; 2: 2 -> 0; 3: B did not settle (dropped); 4: both 1.
+  const PairedCounts p = paired_counts({0, 0, 2, 1, 1}, {0, 1, 0, -1, 1}, 3);
+  EXPECT_EQ(p.pairs, 4u);
+  EXPECT_EQ(p.dropped, 1u);
+  EXPECT_EQ(p.a, (Counts{2, 1, 1}));
+  EXPECT_EQ(p.b, (Counts{2, 2, 0}));
+  EXPECT_EQ(p.a_only, (Counts{1, 0, 1}));
+  EXPECT_EQ(p.b_only, (Counts{1, 1, 0}));
+  EXPECT_NO_THROW(equivalence_paired(p.a, p.b, p.a_only, p.b_only, absolute_margin(0.5)));
+  EXPECT_THROW(paired_counts({0, 1}, {0}, 3), std::invalid_argument);
+  EXPECT_THROW(paired_counts({0, 3}, {0, 1}, 3), std::invalid_argument);
+}
+
 TEST(Equivalence, RelativeMarginOnARareOutcome) {
   // A coin's edge at 1% of 1e5 tosses, margin 0.2 p_edge = 0.002 (pooled p): se = 4.45e-4.
   const Counts a{49'500, 49'500, 1000};
@@ -117,6 +134,31 @@ TEST(Equivalence, RelativeMarginOnARareOutcome) {
   EXPECT_TRUE(none.outcomes[2].equivalent);
   EXPECT_EQ(none.outcomes[2].margin, 0.0);
   EXPECT_TRUE(none.equivalent);  // heads and tails within 20 % of 0.5: z = 4.1 and 5.0 at 1000 tosses
+}
+
+// run_tosses' per-toss outcomes (what `toss --outcomes` writes): the counts they add up to, the
+// same on any number of threads.
+TEST(RunTosses, PerTossOutcomesAreTheCountsOnAnyThreads) {
+  const DieModel m = compile(testing::fair_scene());
+  std::vector<std::int16_t> one, two;
+  RunConfig cfg;
+  cfg.seed = 7;
+  cfg.tosses = 700;
+  cfg.threads = 1;
+  cfg.outcomes = &one;
+  const RunCounts c1 = run_tosses(m, cfg);
+  cfg.threads = 2;
+  cfg.outcomes = &two;
+  const RunCounts c2 = run_tosses(m, cfg);
+  ASSERT_EQ(one.size(), 700u);
+  EXPECT_EQ(one, two);
+  EXPECT_EQ(c1, c2);
+  Counts n(6, 0);
+  for (const std::int16_t o : one) {
+    ASSERT_GE(o, 0);
+    ++n[static_cast<std::size_t>(o)];
+  }
+  EXPECT_EQ(n, c1.faces);
 }
 
 TEST(Equivalence, BadInputThrows) {

@@ -173,5 +173,26 @@ FaceCounts read_face_counts(const std::string& path) {
   return fc;
 }
 
+std::vector<int> read_toss_outcomes(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw SceneError(path, "", "", "cannot open file");
+  std::vector<int> out;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string l = trim(line);
+    if (l.empty() || l[0] == '#') continue;
+    char* end = nullptr;
+    const long v = std::strtol(l.c_str(), &end, 10);
+    if (*end != '\0' || v < -1 || v > 999)
+      throw SceneError(path, "line " + std::to_string(line_no), "'" + l + "'",
+                       "expected one outcome label per toss (an integer in [0, 999], or -1: not settled); "
+                       "the output of `dicesim toss --outcomes`");
+    out.push_back(static_cast<int>(v));
+  }
+  if (out.empty()) throw SceneError(path, "", "", "no tosses: expected the output of `dicesim toss --outcomes`");
+  return out;
+}
 
 }  // namespace dicesim

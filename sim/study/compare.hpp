@@ -49,6 +49,11 @@ Interval difference_interval(std::uint64_t x_a, std::uint64_t n_a, std::uint64_t
 // naming the file, the line and what is allowed; at least 2 faces, not all 0.
 FaceCounts read_face_counts(const std::string& path);
 
+// Per-toss outcomes (`dicesim toss --outcomes FILE`): '#' comment lines, then one line per toss in
+// index order, its outcome label, or -1 for a toss that did not settle. Throws SceneError naming
+// the file and line.
+std::vector<int> read_toss_outcomes(const std::string& path);
+
 // Compares two results. The label sets must be equal (throws std::invalid_argument otherwise).
 Comparison compare_counts(const FaceCounts& a, const FaceCounts& b);
 

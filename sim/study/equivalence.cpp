@@ -103,6 +103,33 @@ Equivalence equivalence_unpaired(const std::vector<std::uint64_t>& a, const std:
   return finish(std::move(out), alpha, false);
 }
 
+PairedCounts paired_counts(const std::vector<std::int16_t>& a, const std::vector<std::int16_t>& b, int outcomes) {
+  if (a.size() != b.size())
+    throw std::invalid_argument("paired outcomes: the runs have " + std::to_string(a.size()) + " and " +
+                                std::to_string(b.size()) + " tosses (pairs need the same toss indices)");
+  const auto k = static_cast<std::size_t>(outcomes);
+  PairedCounts p{std::vector<std::uint64_t>(k, 0), std::vector<std::uint64_t>(k, 0), std::vector<std::uint64_t>(k, 0),
+                 std::vector<std::uint64_t>(k, 0), 0, 0};
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i] < -1 || a[i] >= outcomes || b[i] < -1 || b[i] >= outcomes)
+      throw std::invalid_argument("paired outcomes: toss " + std::to_string(i) + " has an outcome outside [-1, " +
+                                  std::to_string(outcomes) + ")");
+    if (a[i] < 0 || b[i] < 0) {
+      ++p.dropped;
+      continue;
+    }
+    const auto ia = static_cast<std::size_t>(a[i]), ib = static_cast<std::size_t>(b[i]);
+    ++p.pairs;
+    ++p.a[ia];
+    ++p.b[ib];
+    if (ia != ib) {
+      ++p.a_only[ia];
+      ++p.b_only[ib];
+    }
+  }
+  return p;
+}
+
 Equivalence equivalence_paired(const std::vector<std::uint64_t>& a, const std::vector<std::uint64_t>& b,
                                const std::vector<std::uint64_t>& a_only, const std::vector<std::uint64_t>& b_only,
                                const Margin& margin, double alpha) {

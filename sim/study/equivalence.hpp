@@ -19,7 +19,9 @@
 // estimated from the discordant counts (b_i: A is i and B is not; c_i: B is i and A is not):
 // var D = (b_i + c_i) / n - d^2, se = sqrt(var D / n). Positively correlated pairs (the usual case:
 // a small change of the integrator leaves most tosses' outcomes alone) make this se much smaller
-// than the unpooled one; the unpaired test is then valid but conservative.
+// than the unpooled one; the unpaired test is then valid but conservative. (The normal
+// approximation wants a fair number of discordant tosses; with very few the interval is narrow
+// because the runs barely differ: |d| <= (b_i + c_i) / n holds exactly.)
 // Pure computation: nothing here prints.
 #pragma once
 
@@ -76,6 +78,16 @@ Equivalence equivalence_unpaired(const std::vector<std::uint64_t>& a, const std:
 // Two runs over the same n toss indices: counts a and b (each summing to n) and, per outcome, the
 // discordant counts a_only[i] (A gave i, B did not) and b_only[i] (B gave i, A did not); necessarily
 // a[i] - b[i] == a_only[i] - b_only[i] (checked).
+// Two runs' per-toss outcomes over the same toss indices (index i of both is toss i; an outcome
+// index in [0, outcomes), or -1 for a toss that did not settle): the counts equivalence_paired
+// takes, over the tosses settled in both (`dropped`: the others).
+struct PairedCounts {
+  std::vector<std::uint64_t> a, b, a_only, b_only;
+  std::uint64_t pairs = 0, dropped = 0;
+};
+// Throws std::invalid_argument for different lengths or an index outside [-1, outcomes).
+PairedCounts paired_counts(const std::vector<std::int16_t>& a, const std::vector<std::int16_t>& b, int outcomes);
+
 Equivalence equivalence_paired(const std::vector<std::uint64_t>& a, const std::vector<std::uint64_t>& b,
                                const std::vector<std::uint64_t>& a_only, const std::vector<std::uint64_t>& b_only,
                                const Margin& margin, double alpha = 0.10);

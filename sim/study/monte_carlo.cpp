@@ -50,6 +50,7 @@ RunCounts run_tosses(const DieModel& m, const RunConfig& cfg) {
   // most about one per thread). A cancelled run thus returns exactly the tosses 0..k-1 of its
   // longest complete prefix: the same counts as a run of k tosses (what an interrupted toss reports).
   RunCounts total(m.outcomes());
+  if (cfg.outcomes) cfg.outcomes->assign(cfg.tosses, std::int16_t{-1});  // each thread writes its own indices
   std::mutex total_mu;
   std::uint64_t merged_chunks = 0;
   std::map<std::uint64_t, RunCounts> ahead;
@@ -63,7 +64,9 @@ RunCounts run_tosses(const DieModel& m, const RunConfig& cfg) {
       RunCounts local(m.outcomes());
       for (std::uint64_t i = lo; i < hi; ++i) {
         if (cancelled()) return;  // this chunk is dropped: the prefix ends before it
-        local.add(toss(m, cfg.seed, cfg.first + i));
+        const TossResult r = toss(m, cfg.seed, cfg.first + i);
+        if (cfg.outcomes && r.status == TossStatus::Settled) (*cfg.outcomes)[i] = static_cast<std::int16_t>(r.outcome);
+        local.add(r);
       }
       {
         std::lock_guard lock(total_mu);

@@ -38,6 +38,10 @@ struct RunConfig {
   std::function<void(std::uint64_t, std::uint64_t)> progress;
   // Set to true from anywhere to stop early: no new chunk starts; counts cover whole chunks only.
   const std::atomic<bool>* cancel = nullptr;
+  // If set: resized to `tosses`, entry i the outcome index (label order) of toss first + i, -1 if
+  // it did not settle (a cancelled run's entries past its prefix: unspecified). For paired
+  // comparisons of two runs over the same indices (sim/study/equivalence.hpp).
+  std::vector<std::int16_t>* outcomes = nullptr;
 };
 
 RunCounts run_tosses(const DieModel& m, const RunConfig& cfg);
