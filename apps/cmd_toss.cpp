@@ -67,6 +67,11 @@ int run_toss(const TossArgs& a) {
     std::fprintf(stderr, "dicesim: error: --outcomes excludes --shard and --target-halfwidth (it records tosses 0..N-1)\n");
     return kExitBadInput;
   }
+  if (!a.outcomes.empty() && a.tosses > 100'000'000ULL) {
+    std::fprintf(stderr, "dicesim: error: --outcomes with -n %llu: at most 100000000 tosses (a line per toss, kept in memory)\n",
+                 static_cast<unsigned long long>(a.tosses));
+    return kExitBadInput;
+  }
   std::ofstream outcomes_file;  // opened now: a path that cannot be written is bad input, not a lost run
   if (!a.outcomes.empty()) {
     outcomes_file.open(a.outcomes);

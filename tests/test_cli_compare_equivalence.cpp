@@ -121,6 +121,8 @@ TEST(CliCompareEquivalence, PairedByTossIndex) {
   const CliRun swapped = cli("compare " + a + " " + b + " --margin 0.01 --paired " + ob + " " + oa);
   expect_bad_input(swapped, {"must equal A's count"});  // the two runs' counts differ (checked: 499 / 500 on face 1)
   expect_bad_input(cli("toss scenes/fair.toml -n 100 --shard 0/2 --outcomes " + oa), {"--outcomes", "--shard"});
+  expect_bad_input(cli("toss scenes/fair.toml -n 1e9 --outcomes " + oa), {"--outcomes", "100000000"});
+  expect_bad_input(cli("toss scenes/fair.toml -n 10 --outcomes /nonexistent-dir/o.txt"), {"--outcomes", "cannot write"});
   std::ofstream(oa) << "1\n2\nseven\n";
   expect_bad_input(cli("compare " + a + " " + b + " --margin 0.01 --paired " + oa + " " + ob), {"line 3", "'seven'"});
 }
