@@ -499,6 +499,7 @@ dicesim_lcm::probabilities Aggregator::snapshot() const {
   int kind = 0;
   c.corrections.for_each([&](const char*, std::uint64_t n) { m.corrections[kind++] = static_cast<std::int64_t>(n); });
   m.rejected_unauthenticated = static_cast<std::int64_t>(health_.unauthenticated);
+  m.provenance = cfg_.provenance;
   return m;
 }
 

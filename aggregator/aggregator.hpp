@@ -41,6 +41,9 @@ struct AggregatorConfig {
   // The run's key (messages/auth.hpp): empty, no authentication; else every message out is sealed
   // and every message in must open, or it is dropped and counted (Health::unauthenticated).
   std::vector<std::uint8_t> key;
+  // What made the run, as a JSON object (apps/provenance.hpp's provenance_json, dumped): every
+  // probabilities message carries it, so the final answer on the wire says how it was made.
+  std::string provenance;
 };
 
 // Why messages were ignored: the aggregator's health, published in `probabilities`.

@@ -133,6 +133,17 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
   }
   const wire::RunSpec& spec = cfg.spec;
   logging::set_run_id(spec.run_id);
+  // The provenance the answer carries on the wire (every probabilities message) and in the report:
+  // the user's scene, overrides and hash as `toss` reports them (auto's choice travels to the
+  // workers as one more override, prepare_run, which is how the run was made, not what was asked).
+  // A resumed run has only the checkpoint's spec. threads: the workers `run` started; 0 for
+  // `aggregate`, whose workers come from elsewhere (the report counts the most seen at once).
+  const auto run_provenance = [&](int threads) {
+    return resume ? make_provenance(spec.origin, spec.overrides, wire::spec_scene_sha256(spec), model, spec.seed, spec.total, threads)
+                  : make_provenance(a.scene.path, a.scene.applied_overrides(),
+                                    scene_sha256(a.scene.path, a.scene.applied_overrides()), model, spec.seed, spec.total, threads);
+  };
+  cfg.provenance = provenance_json(run_provenance(workers)).dump();
 
   ProgressBar bar;
   std::size_t refusals_shown = 0;
@@ -226,14 +237,7 @@ int aggregate_and_report(const AggregateArgs& a, const std::string& url, std::in
                            static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
   }
   r.elapsed_s = res.run_elapsed_s;
-  // The user's scene and overrides, as `toss` reports them: auto's choice travels to the workers as
-  // one more override (prepare_run), which is how the run was made, not what was asked. A resumed
-  // run has only the checkpoint's spec.
-  if (resume)
-    r.provenance = make_provenance(spec.origin, spec.overrides, wire::spec_scene_sha256(spec), model, spec.seed, spec.total, r.threads);
-  else
-    r.provenance = make_provenance(a.scene.path, a.scene.applied_overrides(), scene_sha256(a.scene.path, a.scene.applied_overrides()),
-                                   model, spec.seed, spec.total, r.threads);
+  r.provenance = run_provenance(r.threads);
   print_report(r, a.json);
   return kExitOk;
 }

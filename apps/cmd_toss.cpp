@@ -140,7 +140,7 @@ void register_toss(CLI::App& app, int& exit_code) {
       "           impulse (`dicesim info SCENE` says which and why)\n"
       "  impulse  a real, unfair die or coin: friction, rolling, tipping to rest; its accuracy knob is\n"
       "           sim.contact_step (default 3 ms for polyhedra, 1 ms for cylinders)\n"
-      "  stepped  the reference (fixed 0.2 ms steps), over 10x slower than impulse: to check a new die\n"
+      "  stepped  the reference (fixed 0.2 ms steps), ~6x slower than impulse: to check a new die\n"
       "  paper    only to reproduce the seed's tables (frictionless corners, a rebound-speed stop)\n"
       "  static   a die placed, not thrown (random orientation, quasi-static roll); instant");
   args->scene.add_to(cmd);

@@ -50,6 +50,7 @@ struct Printer {
   const WatchArgs* args;
   wire::Sealer sealer;  // an authenticated run: only answers whose seal opens are shown
   bool finished = false;
+  std::int64_t provenance_shown = 0;  // the run whose provenance was printed last (once per run)
   std::uint64_t malformed = 0;  // undecodable answers (e.g. more than kMaxOutcomes), dropped
   const char* legacy = nullptr;  // an answer of the six-outcome wire was heard
   void handle(const lcm::ReceiveBuffer* rb, const std::string& channel) {
@@ -64,6 +65,11 @@ struct Printer {
     }
     if (args->run != 0 && m->run_id != args->run) return;
     std::printf("%s\n", answer_line(*m).c_str());
+    // The finished answer says what made it (the aggregator's provenance, a JSON object).
+    if (m->finished && m->run_id != provenance_shown && !m->provenance.empty()) {
+      provenance_shown = m->run_id;
+      std::printf("run %lld provenance: %s\n", static_cast<long long>(m->run_id), m->provenance.c_str());
+    }
     std::fflush(stdout);
     if (m->finished) finished = true;
   }
@@ -105,7 +111,9 @@ void register_watch(CLI::App& app, int& exit_code) {
   CLI::App* cmd = app.add_subcommand(
       "watch",
       "Follow runs live: one line per answer an aggregator publishes on DICESIM_PROBABILITIES\n"
-      "(4 a second): progress, live workers, each face's probability with its 95% half-width.\n"
+      "(4 a second): progress, live workers, each face's probability with its 95% half-width;\n"
+      "when a run finishes, one line more: 'run ID provenance: {JSON}' (version, scene hash,\n"
+      "overrides, fidelity, seed, tosses: what made the answer).\n"
       "Runs until Ctrl-C, or until a run finishes with --until-finished.\n\n"
       "Examples:\n"
       "  dicesim watch\n"

@@ -6,14 +6,15 @@
 namespace dicesim {
 
 Provenance fit_provenance(const std::string& scene, const FitOptions& opt, const std::string& fidelity,
-                          const std::string& fidelity_reason) {
+                          const std::string& fidelity_reason, const std::vector<std::string>& own) {
   Provenance p;
   p.scene = scene;
+  p.overrides = opt.overrides;
+  p.overrides.insert(p.overrides.end(), own.begin(), own.end());
   try {
-    p.scene_sha256 = scene_sha256(scene, opt.overrides);
+    p.scene_sha256 = scene_sha256(scene, p.overrides);
   } catch (const std::exception&) {  // not a file (a scene given as text): its hash is unknown
   }
-  p.overrides = opt.overrides;
   p.fidelity = fidelity;
   p.fidelity_reason = fidelity_reason;
   p.seed = opt.seed;
@@ -50,7 +51,21 @@ nlohmann::json fit_json(const FitResult& r, const FitOptions& opt) {
       fitted.push_back({{"label", d.labels[k]}, {"p", json_number(d.fitted[k])}, {"observed", d.observed[k]}, {"data", s}});
       if (k < d.names.size()) fitted.back()["name"] = d.names[k];  // a coin's side
     }
-    data.push_back({{"scene", d.scene}, {"counts", d.source}, {"fitted_tosses", d.fitted_tosses}, {"gof", chi2_json(d.gof)}});
+    // Each data set's own scene as it was simulated (every data set's overrides, then its own): the
+    // top-level provenance names the first only.
+    std::vector<std::string> overrides = opt.overrides;
+    overrides.insert(overrides.end(), d.overrides.begin(), d.overrides.end());
+    nlohmann::json sha = nullptr;
+    try {
+      sha = scene_sha256(d.scene, overrides);
+    } catch (const std::exception&) {  // not a file: its hash is unknown
+    }
+    data.push_back({{"scene", d.scene},
+                    {"overrides", overrides},
+                    {"scene_sha256", sha},
+                    {"counts", d.source},
+                    {"fitted_tosses", d.fitted_tosses},
+                    {"gof", chi2_json(d.gof)}});
   }
   nlohmann::json rounds = nlohmann::json::array();
   for (const FitRound& fr : r.rounds)
@@ -70,7 +85,8 @@ nlohmann::json fit_json(const FitResult& r, const FitOptions& opt) {
           {"elapsed_s", r.elapsed_s},
           {"partial", false},
           {"provenance", provenance_json(fit_provenance(r.data.empty() ? "" : r.data.front().scene, opt, r.fidelity,
-                                                         r.fidelity_reason))}};
+                                                         r.fidelity_reason,
+                                                         r.data.empty() ? std::vector<std::string>{} : r.data.front().overrides))}};
 }
 
 }  // namespace dicesim

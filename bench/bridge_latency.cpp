@@ -36,7 +36,7 @@ bool wait_for(dds_entity_t reader, dds_entity_t waitset, std::int64_t run, std::
     const int n = dds_take(reader, samples, infos, 8, 8);
     bool got = false;
     for (int k = 0; k < n; ++k) {
-      const auto* s = static_cast<const dicesim_dds_probabilities_v2*>(samples[k]);
+      const auto* s = static_cast<const dicesim_dds_probabilities_v3*>(samples[k]);
       if (infos[k].valid_data && s->run_id == run && s->done == seq) got = true;
     }
     if (n > 0) dds_return_loan(reader, samples, n);
@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
 
   b::DdsEntity participant(dds_create_participant(DDS_DOMAIN_DEFAULT, nullptr, nullptr), "participant");
   const b::Qos qos = b::latest_per_run_qos();
-  b::DdsEntity topic(dds_create_topic(participant.get(), &dicesim_dds_probabilities_v2_desc, b::kProbabilitiesTopic,
+  b::DdsEntity topic(dds_create_topic(participant.get(), &dicesim_dds_probabilities_v3_desc, b::kProbabilitiesTopic,
                                       qos.get(), nullptr),
                      "topic");
   b::DdsEntity reader(dds_create_reader(participant.get(), topic.get(), qos.get(), nullptr), "reader");

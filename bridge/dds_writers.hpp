@@ -20,7 +20,7 @@ class DdsWriters {
   // Throws std::runtime_error if any entity cannot be created.
   DdsWriters(const std::string& config_uri, std::uint32_t domain_id);
 
-  void write(const dicesim_dds_probabilities_v2& s);
+  void write(const dicesim_dds_probabilities_v3& s);
   void write(const dicesim_dds_run_status& s);
   void dispose(std::int64_t run_id);  // both topics: the run is gone for late subscribers too
   std::int64_t write_errors() const { return write_errors_; }

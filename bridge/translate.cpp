@@ -1,6 +1,7 @@
 #include "bridge/translate.hpp"
 
 #include <cstdint>
+#include <iterator>
 #include <vector>
 
 namespace dicesim::bridge {
@@ -17,8 +18,8 @@ Seq view(const std::vector<T>& v) {
 }
 }  // namespace
 
-dicesim_dds_probabilities_v2 to_dds(const dicesim_lcm::probabilities& m) {
-  dicesim_dds_probabilities_v2 s{};
+dicesim_dds_probabilities_v3 to_dds(const dicesim_lcm::probabilities& m) {
+  dicesim_dds_probabilities_v3 s{};
   s.run_id = m.run_id;
   s.utime = m.utime;
   // decode() admits 1..120 outcomes, the sequences' bound.
@@ -41,6 +42,10 @@ dicesim_dds_probabilities_v2 to_dds(const dicesim_lcm::probabilities& m) {
   s.rejected_range = m.rejected_range;
   s.released = m.released;
   s.rejected_unauthenticated = m.rejected_unauthenticated;
+  static_assert(std::size(decltype(s.corrections){}) == std::size(decltype(m.corrections){}));
+  for (std::size_t k = 0; k < std::size(s.corrections); ++k) s.corrections[k] = m.corrections[k];
+  // A view, as the sequences (the sample is written before m goes away).
+  s.provenance = const_cast<char*>(m.provenance.c_str());
   return s;
 }
 

@@ -7,6 +7,6 @@
 namespace dicesim::bridge {
 
 // The sample borrows m's per-outcome arrays (no copy, nothing to free): write it while m lives.
-dicesim_dds_probabilities_v2 to_dds(const dicesim_lcm::probabilities& m);
+dicesim_dds_probabilities_v3 to_dds(const dicesim_lcm::probabilities& m);
 
 }  // namespace dicesim::bridge

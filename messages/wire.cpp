@@ -79,9 +79,9 @@ bool plausible_probabilities(const void* data, std::size_t len) {
   Walker w(data, len);
   std::int32_t n = 0;
   // hash utime run_id; n labels (4) + counts p ci_lo ci_hi (8 each); then 173 bytes of scalars
-  // (nine corrections of 8 bytes among them)
+  // (nine corrections of 8 bytes among them), then the provenance string
   return w.skip(8 + 8 + 8) && w.count(n, 36) && n >= 1 && n <= kMaxOutcomes && w.skip(static_cast<std::size_t>(n) * 36) &&
-         w.skip(173) && w.at_end();
+         w.skip(173) && w.str() && w.at_end();
 }
 
 bool valid_outcome_labels(const std::vector<std::int32_t>& labels) {
@@ -103,6 +103,8 @@ const char* legacy_format(const void* data, std::size_t len) {
     // ... and of the wire whose corrections had four kinds (before the sustained phase's guards).
     case 0xa777923107885cfeULL: return "toss_batch of the four-corrections wire";
     case 0x763722945abe8778ULL: return "probabilities of the four-corrections wire (corrections[4])";
+    // ... and the answer before it carried its provenance.
+    case 0x763722945aa34978ULL: return "probabilities of the wire without provenance";
     default: return nullptr;
   }
 }

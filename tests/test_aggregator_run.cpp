@@ -37,6 +37,7 @@ struct Net {
   int steps = 0;
   double now = 0.0;
   std::vector<Message> all_batches;  // for replays
+  std::vector<std::uint8_t> last_answer;  // the last probabilities message published
 
   auto sender() {
     return [this](const char* ch, const std::vector<std::uint8_t>& b) { queue.push_back({ch, b}); };
@@ -67,6 +68,7 @@ struct Net {
     while (!queue.empty()) {
       Message m = std::move(queue.front());
       queue.pop_front();
+      if (m.channel == wire::kProbabilities) last_answer = m.bytes;
       if (m.channel == wire::kTossBatch) {
         all_batches.push_back(m);
         if (duplicate > 0 && std::uniform_real_distribution<>(0, 1)(rng) < duplicate) deliver(m);
@@ -136,6 +138,20 @@ TEST(AggregatorRun, SustainedPhaseGuardsArriveAsCounted) {
   ASSERT_TRUE(net.run());
   EXPECT_EQ(net.agg->result().corrections, ref.corrections);
   EXPECT_EQ(net.agg->result(), ref);
+}
+
+// The final answer on the wire says what made it (issue 35): the provenance the aggregator was
+// given travels in every probabilities message, the finished one included.
+TEST(AggregatorRun, FinalAnswerCarriesTheProvenance) {
+  Fixture f(800);
+  f.cfg.provenance = R"({"scene_sha256":"5ca1ab1e","seed":3,"tosses":800})";
+  Net net = make_net(f, 2);
+  ASSERT_TRUE(net.run());
+  for (int i = 0; i < 3; ++i) net.step();
+  const auto m = wire::decode<dicesim_lcm::probabilities>(net.last_answer.data(), net.last_answer.size());
+  ASSERT_TRUE(m.has_value());
+  EXPECT_EQ(m->finished, 1);
+  EXPECT_EQ(m->provenance, f.cfg.provenance);
 }
 
 TEST(AggregatorRun, LossyBusStillGivesIdenticalCounts) {

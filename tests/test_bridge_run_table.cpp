@@ -65,7 +65,7 @@ TEST(BridgeTranslate, EveryFieldCrosses) {
   m.tosses_per_s = 123.5, m.finished = 1, m.workers = 3;
   m.duplicates = 4, m.rejected_foreign = 5, m.rejected_malformed = 6, m.rejected_range = 7, m.released = 8;
   m.rejected_unauthenticated = 9;
-  const dicesim_dds_probabilities_v2 s = b::to_dds(m);
+  const dicesim_dds_probabilities_v3 s = b::to_dds(m);
   EXPECT_EQ(s.run_id, 42);
   EXPECT_EQ(s.utime, 17);
   ASSERT_EQ(s.labels._length, 20u);

@@ -5,7 +5,7 @@
 // on every x86-64 machine, unlike glibc's, which picks an FMA variant at run time). Moving from
 // libm to it changed Die 2 (+1 -1 on faces 1 and 3, 33593 -> 33596 bounces) and fair (faces 1, 5, 6:
 // +1 +1 -2; 34138 -> 34137 bounces) here; over 10^6 tosses 22 (Die 1), 58 (Die 2) and 24 (Die 3)
-// faces changed, every face count within its interval (docs/performance.md). A deliberate change
+// faces changed, every face count within its interval (commit 8ae49a4). A deliberate change
 // to the paper physics needs them regenerated: run the test and copy the "actual" values after
 // checking the change is intended.
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 /* An external subscriber to a dicesim run over DDS: plain C, the Cyclone DDS C API and the
  * types idlc generates from dicesim's messages/ IDL files -- nothing else of dicesim. Prints one line
- * per sample of `dicesim_probabilities` (type dicesim_dds::probabilities_v2: any number of outcomes,
+ * per sample of `dicesim_probabilities` (type dicesim_dds::probabilities_v3: any number of outcomes,
  * as bounded sequences) and `dicesim_run_status`.
  *
  *   dicesim_dds_subscriber [--json] [--topic probabilities|status|both] [--run ID]
@@ -49,7 +49,7 @@ static const char* state_name(dicesim_dds_run_state s) {
 }
 
 /* rx_utime - utime is the latency from the aggregator (same host, same clock). */
-static void print_probabilities(const dicesim_dds_probabilities_v2* m, int json, int64_t rx) {
+static void print_probabilities(const dicesim_dds_probabilities_v3* m, int json, int64_t rx) {
   uint32_t f, n = m->labels._length;
   /* The sequences have one entry per outcome; a sample whose lengths differ prints the common part. */
   if (m->counts._length < n) n = m->counts._length;
@@ -65,7 +65,10 @@ static void print_probabilities(const dicesim_dds_probabilities_v2* m, int json,
     for (f = 0; f < n; ++f)
       printf("%s{\"face\":%d,\"count\":%" PRId64 ",\"p\":%.17g,\"ci95\":[%.17g,%.17g]}", f ? "," : "",
              m->labels._buffer[f], m->counts._buffer[f], m->p._buffer[f], m->ci_lo._buffer[f], m->ci_hi._buffer[f]);
-    printf("]}\n");
+    /* corrections in corrections.hpp's order; the provenance is itself a JSON object (null if none). */
+    printf("],\"corrections\":[");
+    for (f = 0; f < 9; ++f) printf("%s%" PRId64, f ? "," : "", m->corrections[f]);
+    printf("],\"provenance\":%s}\n", m->provenance && m->provenance[0] ? m->provenance : "null");
   } else {
     printf("run %" PRId64 " %s %" PRId64 "/%" PRId64 " tosses, %d workers |", m->run_id,
            m->finished ? "FINISHED" : "running", m->done, m->total, m->workers);
@@ -140,7 +143,7 @@ int main(int argc, char** argv) {
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
   dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
   dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
-  topics[0] = dds_create_topic(participant, &dicesim_dds_probabilities_v2_desc, "dicesim_probabilities", qos, NULL);
+  topics[0] = dds_create_topic(participant, &dicesim_dds_probabilities_v3_desc, "dicesim_probabilities", qos, NULL);
   topics[1] = dds_create_topic(participant, &dicesim_dds_run_status_desc, "dicesim_run_status", qos, NULL);
   waitset = dds_create_waitset(participant);
   for (i = 0; i < 2; ++i) {
@@ -175,7 +178,7 @@ int main(int argc, char** argv) {
         const int64_t rx = now_utime();
         if (!infos[k].valid_data) continue; /* a disposed or unregistered run */
         if (i == 0) {
-          const dicesim_dds_probabilities_v2* m = samples[k];
+          const dicesim_dds_probabilities_v3* m = samples[k];
           if (run_filter && m->run_id != run_filter) continue;
           print_probabilities(m, json, rx);
           if (until_finished && m->finished) done = 1;

@@ -50,3 +50,21 @@ def test_fit_bad_input(dicesim):
         dicesim.fit([DIE1], [COUNTS, COUNTS], ["floor.restitution=0.1:0.9"], n=2000)
     with pytest.raises(ValueError, match="TOML text"):
         dicesim.fit(dicesim.scene_from_toml("[materials.m]\ndensity = 1000.0\n[die]\nmaterial = \"m\"\n"), COUNTS, ["floor.restitution=0.1:0.9"])
+
+
+def test_fit_provenance_names_every_data_sets_scene(dicesim):
+    # Issue 35: a fit's provenance hashes the scene as simulated, the data set's own overrides
+    # included; a joint fit names each data set's scene, overrides and hash.
+    heavy = dicesim.load_scene(DIE1, set={"floor.restitution": 0.4})
+    r = dicesim.fit([heavy, DIE1], [COUNTS, COUNTS], {"materials.steel.density": (3000, 20000)}, n=2000,
+                    fidelity="static")
+    plain = dicesim.fit(DIE1, COUNTS, {"materials.steel.density": (3000, 20000)}, n=2000, fidelity="static")
+    first, second = r["data"]
+    assert "floor.restitution=0.4" in first["overrides"]
+    assert "floor.restitution=0.4" not in second["overrides"]
+    assert first["scene_sha256"] != second["scene_sha256"]
+    assert second["scene_sha256"] == plain["data"][0]["scene_sha256"]
+    # the top-level provenance is the first data set's scene as simulated
+    assert r["provenance"]["scene_sha256"] == first["scene_sha256"]
+    assert r["provenance"]["overrides"] == first["overrides"]
+    assert plain["provenance"]["scene_sha256"] == second["scene_sha256"]

@@ -570,6 +570,7 @@ FitResult Fitter::run() {
         for (std::size_t s = 0; s < S; ++s) {
           FitDataResult dr;
           dr.scene = data_[s].scene;
+          dr.overrides = data_[s].overrides;
           dr.source = data_[s].source;
           dr.labels = labels_[s];
           for (Eigen::Index k = 0; k < n_[s].size(); ++k) dr.observed.push_back(static_cast<std::uint64_t>(n_[s][k]));
@@ -708,6 +709,7 @@ FitResult Fitter::run() {
     const PointCounts pc = simulate(at, tosses_, "fitted")[0];
     FitDataResult dr;
     dr.scene = data_[s].scene;
+    dr.overrides = data_[s].overrides;
     dr.source = data_[s].source;
     dr.labels = labels_[s];
     if (at[0].outcome_labels == dr.labels) dr.names = outcome_names(at[0]);

@@ -103,6 +103,7 @@ struct FitParamResult {
 
 struct FitDataResult {
   std::string scene, source;
+  std::vector<std::string> overrides;   // the data set's own (FitData::overrides)
   std::vector<int> labels;              // the die's outcomes, ascending
   std::vector<std::string> names;       // a coin's side per label (outcome_names); empty for a die
   std::vector<std::uint64_t> observed;  // per label

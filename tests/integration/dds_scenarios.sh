@@ -52,7 +52,9 @@ same_as_json() {
   jq -e --slurpfile d "$work/dds_final.json" '
       $d[0] as $d
       | .settled == $d.settled and .unresolved == $d.unresolved and .invalid == $d.invalid
-        and .tosses == $d.done and ([.faces[] | [.face, .count, .p, .ci95]] == [$d.faces[] | [.face, .count, .p, .ci95]])' \
+        and .tosses == $d.done and ([.faces[] | [.face, .count, .p, .ci95]] == [$d.faces[] | [.face, .count, .p, .ci95]])
+        and (.provenance | {version, scene, scene_sha256, overrides, fidelity, seed, tosses})
+            == ($d.provenance | {version, scene, scene_sha256, overrides, fidelity, seed, tosses})' \
       "$3" > /dev/null || { echo "aggregator: $(jq -c '{settled, unresolved, invalid, faces}' "$3")" >&2;
                             echo "over DDS:   $(cat "$work/dds_final.json")" >&2;
                             fail "values over DDS differ from the aggregator's JSON"; }
@@ -112,6 +114,9 @@ case "$scenario" in
     # `dicesim watch` (the CLI way to watch) saw the same run to its end.
     wait "$watchp" || fail "dicesim watch exited $?"
     grep -q "^run $run  FINISHED 400000/400000" "$work/watch.out" || fail "dicesim watch did not print the finished run"
+    sha=$(jq -r .provenance.scene_sha256 "$work/run.json")
+    grep -q "^run $run provenance: .*\"scene_sha256\":\"$sha\"" "$work/watch.out" ||
+      fail "dicesim watch did not print the run's provenance (scene sha256 $sha)"
     sleep 0.3
     subscriber --topic status --count 1 --timeout 2 > "$work/status.jsonl" || fail "no run status"
     grep -qF "\"run_id\":$run," "$work/status.jsonl" || fail "run status of another run: $(cat "$work/status.jsonl")"
