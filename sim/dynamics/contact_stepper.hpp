@@ -193,7 +193,7 @@ class FixedStepper {
   bool try_step_with(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full, double bias);
   // A curved die's support solve for a step of length d (gravity's kick already in s): the plastic
   // solve, rolling and pivoting resistance, and the touching rims' lowest points held on the floor
-  // at the step's end by the curvature impulse at the step's middle (contact_stepper.cpp). Leaves
+  // at the step's end by the curvature impulse at the step's middle (rim_support.cpp). Leaves
   // s and rot such that rot's free motion of s for d is the step's motion. full: the step of
   // length h (it decides rims_new_).
   void rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
@@ -217,11 +217,11 @@ class FixedStepper {
     return model_g + (miss + miss_rate_ * t) * t * (h_ - t);
   }
   // A flat die's prediction of the miss (the corrected model's coefficient) before any shortened
-  // trial: the support solve linearised in the step length at the full step (contact_stepper.cpp).
+  // trial: the support solve linearised in the step length at the full step (contact_location.cpp).
   // Sets miss_rate_. r: the arriving corner's lever at the step's start.
   double predicted_miss(const ContactSet& c, const Vec3& r);
   // A flat die's starting point for model_root: the root in (lo, hi) of the corrected model with
-  // the arriving corner's rotation replaced by a cubic (contact_stepper.cpp); x if none is found.
+  // the arriving corner's rotation replaced by a cubic (contact_location.cpp); x if none is found.
   double hermite_start(double miss, double lo, double hi, double x) const;
   // The root of the corrected model in [lo, hi], given its values f_lo > 0 at lo and f_hi <= 0 at
   // hi: a flat die's by Newton on the model (its slope from the rotation's rate), safeguarded by

@@ -8,7 +8,7 @@
 //     P = -W^-1 u, else a bracketed root in the slip direction; W the contact compliance
 //     (1/m) 1 - [r]x I_w^-1 [r]x, u the point's velocity v + w x r). Several (a polyhedron's or a rim's):
 //     first directly, if every point of an edge or a triangle slides (or lifts), or if every point
-//     sticks (friction_impact.cpp: solve_sliding, solve_sticking; accepted only where Coulomb's
+//     sticks (friction_exact_plastic.cpp: solve_sliding, solve_sticking; accepted only where Coulomb's
 //     law verifies; a rim's only when every point slips past mu times its approach); else projected
 //     Gauss-Seidel where every update is the exact minimiser of the kinetic energy over its own
 //     block (normal: P_n >= 0; tangential: the disc |P_t| <= mu P_n, in the metric of W_tt), so
@@ -16,7 +16,7 @@
 //     speeds; a solve still unconverged at the sweep cap (an edge near the stick-slip boundary:
 //     two corners' compliance has rank 5) is finished by semismooth Newton on the Alart-Curnier
 //     equations; two points it leaves unconverged (a coin on its side, its two rims' lowest points
-//     touching close together: friction_impact.cpp, solve_plastic_pair) are solved exactly by
+//     touching close together: friction_exact_plastic.cpp, solve_plastic_pair) are solved exactly by
 //     their active sets (both stick, one sticks and one slides, both slide), and a solve is
 //     counted (pgs_unconverged) only if that fails too. The lever arms of a
 //     multi-point solve lie in one contact plane (the lowest point's height) when its points are
@@ -124,7 +124,7 @@ ContactSet touching_corners(const DieModel& m, const RigidState& s, double tol);
 // a previous solve (matched by vertex) to start the compression from; `out`: the impulse at every
 // point (compression plus restitution); `geometry`: the set-up shared with other solves of c at
 // s.R (see ContactGeometry). All optional. `direct`: a multi-point plastic solve first tries the
-// direct solves (every point sliding or lifting, then every point sticking; friction_impact.cpp;
+// direct solves (every point sliding or lifting, then every point sticking; friction_exact_plastic.cpp;
 // a curved die's only when every point slips past mu times its approach); false: always the
 // Gauss-Seidel sweeps (the tests compare the two).
 ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,

@@ -1,0 +1,155 @@
+// FixedStepper's trial steps: one step of a given length from a start with its contact set
+// (try_step, try_step_with: a flat die's held corners asked to rise), and the held corners'
+// bookkeeping around it (predicted_step, held_sink, held_energy).
+#include "sim/dynamics/contact_stepper.hpp"
+#include "sim/dynamics/contact_stepper_internal.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "sim/dynamics/friction_impact.hpp"
+
+namespace dicesim {
+
+using stepper_detail::mechanical_energy;
+
+void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full) {
+  const DieModel& m = *m_;
+  // `impulse` (hold_): a flat die's held corners are asked to end the step on the floor, v_n >= b
+  // at every one of them after the solve (the solve on the velocity shifted by -b e_z, then
+  // restored), b = depth / d + a_n d / 2: the shallowest one's depth at the start (what earlier
+  // steps left) and what the free rotation's downward acceleration a_n < 0 of the corners would
+  // sink them within the step (predicted_step). Without it a corner held while the die spins
+  // over it sank a micrometre a step, and kept sinking: up to 0.3 mm in 10^4 Die 1 tosses.
+  // b is at most gravity's kick g d, and the step may not gain energy as the rest rules count
+  // it, kinetic + m g (COM height + the deepest corner's depth) (rest.hpp): the rise lifts the
+  // COM by what the depth falls. At a resting corner, dE = m_eff b^2 / 2 - (m - m_eff)(b g d +
+  // g^2 d^2 / 2) (m_eff = 1 / W_nn), so b = g d costs energy only where m_eff > 3 m / 4 (a corner
+  // nearly under the COM). Checked at the step's end: if it gains, b / 4, then none: the plain
+  // step, which never gains kinetic + m g z (counted, rise_dropped; its corners' depth stays).
+  if (full) full_bias_ = 0.0;
+  if (!hold_ || m.curved() || c.n == 0) {
+    try_step_with(s0, c, d, a, full, 0.0);
+    return;
+  }
+  const double b = std::min(start_shallow_ / d + 0.5 * a_down_ * d, m.gravity * d);
+  if (try_step_with(s0, c, d, a, full, b)) {
+    if (full) full_bias_ = b;
+    return;
+  }
+  if (try_step_with(s0, c, d, a, full, 0.25 * b)) {
+    if (full) full_bias_ = 0.25 * b;
+    return;
+  }
+  try_step_with(s0, c, d, a, full, 0.0);
+  a.rise_dropped = true;
+}
+
+bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full,
+                                 double bias) {
+  const DieModel& m = *m_;
+  // The impact (solved once per step in step(): it does not depend on d) is already in s0.
+  a.s = s0;
+  RigidState& s = a.s;
+  a.impact = impact_;
+  if (impact_) a.imp = imp_;
+  a.next.n = 0;
+  a.capped = false;
+  a.clamped = false;
+  a.unreflected = false;
+  a.risen = bias > 0.0;
+  a.rise_dropped = false;
+  s.velocity.z() -= m.gravity * d;
+  // Built in place (the full step's is kept for model_G; the object is large, so no copies). A
+  // curved die's support solve builds its own (rim_support: the rotation is part of its search).
+  std::optional<TorqueFreeRotation>& slot = full ? full_rot_ : trial_rot_;
+  const bool built = m.curved() && c.n > 0;
+  if (built) rim_support(s, c, d, e_start_, a, slot, full);
+  if (!m.curved() && c.n > 0) {
+    s.velocity.z() -= bias;
+    a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
+    s.velocity.z() += bias;
+  }
+  // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact). A trial of
+  // a step without contact has the full step's rotation exactly (the same s0.R and, with no
+  // impulse, the same angular momentum): it is reused.
+  const TorqueFreeRotation& rot = built                             ? *slot
+                                  : !full && c.n == 0 && full_rot_ ? *full_rot_
+                                                                    : slot.emplace(moments_, s.R,
+                                                                                   Vec3(Iw_start_ * s.omega), full);
+  rot_start_ = s.R;
+  const Vec3 p = s.position, v = s.velocity;
+  // Every body point lies within the bounding radius of the COM (|bottom row| = 1 to rounding, far
+  // inside the relative 1e-9): a full step that ends with the COM that far above the floor cannot
+  // bring a corner below it, and its G is only compared with -touch_tol (the shortened steps'
+  // search, which needs G's value, never starts from such a step). Most of `stepped`'s steps are
+  // in the air: this skips their corner heights (and the rotation's evaluation for them).
+  const double clear = p.z() + v.z() * d - (1.0 + 1e-9) * m.bounding_radius;
+  // The step's end orientation is evaluated once: its bottom row is bit for bit the one
+  // bottom_row(d) returns (the same operations on the same row), so a flat die's corner heights
+  // come from it (a curved die's rim, and d = 0, keep lowest_new's own evaluation).
+  // (Written straight into s: rot holds its own copy of the start.)
+  if (full) {
+    full_p_ = p;
+    full_v_ = v;
+    full_w_ = s.omega;
+  }
+  rot.state(d, s.R, s.omega);
+  if (full && clear > 0.0)
+    a.G = clear;
+  else if (m.curved() || d == 0.0)
+    a.G = lowest_new(c, p, v, rot, d);
+  else
+    a.G = lowest_flat(c, p, v, s.R.row(2).transpose(), d);
+  s.position = p + d * v;
+  if (!(bias > 0.0)) return true;
+  // (New corners below the floor are the located step's business.)
+  a.held_e = held_energy(s, c);
+  return a.held_e <= e_start_ + m.mass * m.gravity * start_depth_max_;
+}
+
+double FixedStepper::predicted_step(const RigidState& s0, const ContactSet& c) {
+  // A held corner r (from the COM) leaves the start's solve with normal velocity >= 0 and then
+  // moves with the free rotation: its height gains a_n d^2 / 2, a_n = e_z . (w x (w x r) + dw/dt x r)
+  // with dw/dt = -I_w^-1 (w x L) (torque-free, L = I_w w). (The solve changes w a little; the
+  // accepted step is checked, step().)
+  const DieModel& m = *m_;
+  const Vec3& w = s0.omega;
+  const Vec3 L = Iw_start_ * w;
+  const Vec3 wb = s0.R.transpose() * (w.cross(L));
+  const Vec3 alpha = -(s0.R * wb.cwiseQuotient(m.principal_moments));
+  double a_min = 0.0;
+  for (int i = 0; i < c.n; ++i) {
+    const Vec3 r = s0.R * m.vertices[static_cast<std::size_t>(c.vertex[i])];
+    a_min = std::min(a_min, (w.cross(w.cross(r)) + alpha.cross(r)).z());
+  }
+  a_down_ = -a_min;
+  if (!(a_min < 0.0)) return h_max_;
+  const double d = std::sqrt(2.0 * max_sink_ / -a_min);
+  return std::clamp(d, h_max_ / kMinStepDivisor, h_max_);
+}
+
+double FixedStepper::held_energy(const RigidState& s, const ContactSet& c) const {
+  const DieModel& m = *m_;
+  const Vec3 z_row = s.R.row(2).transpose();
+  double depth = 0.0;
+  for (int i = 0; i < c.n; ++i)
+    depth = std::max(depth, -(s.position.z() + z_row.dot(m.vertices[static_cast<std::size_t>(c.vertex[i])]) - m.rounding));
+  return mechanical_energy(m, s) + m.mass * m.gravity * depth;
+}
+
+double FixedStepper::held_sink(const RigidState& s0, const RigidState& s, const ContactSet& c, double& depth) const {
+  const DieModel& m = *m_;
+  const Vec3 z0 = s0.R.row(2).transpose(), z1 = s.R.row(2).transpose();
+  double sink = -std::numeric_limits<double>::infinity();
+  depth = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < c.n; ++i) {
+    const Vec3& v = m.vertices[static_cast<std::size_t>(c.vertex[i])];
+    const double d0 = -(s0.position.z() + z0.dot(v) - m.rounding), d1 = -(s.position.z() + z1.dot(v) - m.rounding);
+    sink = std::max(sink, d1 - std::max(0.0, d0));
+    depth = std::max(depth, d1);
+  }
+  return sink;
+}
+
+}  // namespace dicesim
