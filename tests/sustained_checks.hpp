@@ -40,6 +40,20 @@ inline SustainedFactory fixed_steps(double h, bool impulse = true) {
   };
 }
 
+// `impulse`'s sustained phase on a polyhedron: leapfrog steps of error-controlled length (tol,
+// AdaptiveSteps), ceiling h (<= 0: the die's contact_step), as impulse_model.cpp sets it up.
+inline SustainedFactory adaptive_steps(double tol, double h = 0.0) {
+  return [tol, h](const DieModel& m) -> SustainedStep {
+    const double step = h > 0.0 ? h : m.contact_step;
+    const AdaptiveSteps a{.tol = tol, .floor = std::min(kContactStepFloor, step), .threshold_step = m.sustained_step};
+    auto st = std::make_shared<FixedStepper>(m, step, ImpactThreshold::Gravity, held_corner_sink(m), a);
+    return [st](RigidState& s) {
+      st->step(s);
+      return st->last_dt();
+    };
+  };
+}
+
 // The height of s's lowest contact point relative to its COM (< 0).
 inline double lowest_offset(const DieModel& m, const Mat3& R) {
   double low = 0.0;

@@ -97,7 +97,9 @@ struct DieModel {
   Fidelity fidelity_requested = Fidelity::Paper;   // what the scene asked for (may be Auto)
   std::string fidelity_reason;                     // why `fidelity` (dicesim info prints it)
   double step = 2e-4;                              // `stepped` time step (s)
-  double contact_step = 1e-3;                      // `impulse` sustained-contact step (s)
+  double contact_step = 1e-3;                      // `impulse` sustained-contact step's ceiling (s)
+  double contact_tol = 0.0;                        // ... its error tolerance (sim.contact_tol; 0: fixed steps)
+  double sustained_step = 1e-3;                    // the shape's default contact step: impacts are faster than 4 g this (s)
   double gravity = 9.81;
   double stop_speed = 0.1;
   int max_bounces = 1000;

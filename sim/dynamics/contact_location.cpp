@@ -145,7 +145,7 @@ double FixedStepper::predicted_miss(const ContactSet& c, const Vec3& r) {
   // The solve sees the pre-solve normal velocity shifted by the kick g d and the held corners'
   // rise b(d) (try_step): per unit step length g + b'. With no depth at the start b is linear in
   // d (b = d k min(a_n / 2, g)), so b' = b(h) / h exactly for the full step's branch k.
-  const double kick_rate = g + (start_shallow_ > 0.0 ? 0.0 : full_bias_ / h_);
+  const double kick_rate = kick_g_ + (start_shallow_ > 0.0 ? 0.0 : full_bias_ / h_);
   const double speed = full_v_.norm() + full_w_.norm() * m.bounding_radius + 1e-2 * std::sqrt(g * m.bounding_radius);
   Vec3 dF, dM, dF2, dM2;
   bool ok = false;
@@ -185,7 +185,7 @@ double FixedStepper::hermite_start(double miss, double lo, double hi, double x) 
   // evaluation then meets the tolerance). Newton on the cubic, kept in (lo, hi); x, the secant
   // point, if it leaves.
   // The cubic in powers of t: base + v t + H(t) + g (h - t) t + (miss + rate t) t (h - t).
-  const double h = h_, g = m_->gravity;
+  const double h = h_, g = kick_g_;
   const double q0 = hq_[0], p0 = hq_[1], q1 = hq_[2], p1 = hq_[3];
   const double c0 = full_p_.z() - m_->rounding + q0;
   const double c1 = full_v_.z() + p0 + g * h + miss * h;
@@ -229,7 +229,7 @@ double FixedStepper::model_root(const ContactSet& c, double miss, double lo, dou
     // tolerance; fewer evaluations.
     const TorqueFreeRotation& rot = *full_rot_;
     const double curvature =
-        (rot.max_omega() * rot.max_omega() + rot.max_alpha()) * m_->bounding_radius + 2.0 * std::abs(m_->gravity + miss) +
+        (rot.max_omega() * rot.max_omega() + rot.max_alpha()) * m_->bounding_radius + 2.0 * std::abs(kick_g_ + miss) +
         6.0 * std::abs(miss_rate_) * h_;
     const double tol = 1e-3 * touch_tol_;
     double x = hi - f_hi * (hi - lo) / (f_hi - f_lo);
@@ -239,12 +239,12 @@ double FixedStepper::model_root(const ContactSet& c, double miss, double lo, dou
       Vec3 z_rate;
       const Vec3 z_row = rot.bottom_row(x, z_rate);
       double slope = 0.0;
-      g_model = lowest_flat(c, full_p_, full_v_, z_row, z_rate, x, slope) + m_->gravity * (h_ - x) * x;
+      g_model = lowest_flat(c, full_p_, full_v_, z_row, z_rate, x, slope) + kick_g_ * (h_ - x) * x;
       const double f = corrected(g_model, miss, x);
       if (std::abs(f) <= tol) break;
       (f > 0.0 ? lo : hi) = x;
       if (!(hi - lo > 1e-15 * h_)) break;
-      const double dg = slope + m_->gravity * (h_ - 2.0 * x);  // the model's own slope
+      const double dg = slope + kick_g_ * (h_ - 2.0 * x);  // the model's own slope
       const double delta = -f / (dg + (miss + miss_rate_ * x) * (h_ - 2.0 * x) + miss_rate_ * x * (h_ - x));
       const double next = x + delta;
       if (!(next > lo && next < hi)) {

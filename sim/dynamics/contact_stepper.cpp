@@ -17,12 +17,16 @@ namespace dicesim {
 
 using stepper_detail::mechanical_energy;
 
-FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshold, double max_sink)
+FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshold, double max_sink,
+                           const AdaptiveSteps& adaptive)
     : m_(&m),
       moments_(m.principal_moments),
       h_max_(h),
+      adaptive_(adaptive),
+      h_ctrl_(h),
+      kick_g_(adaptive.tol > 0.0 ? 0.5 * m.gravity : m.gravity),
       h_(h),
-      v_impact_(sustained_contact_speed(m, h)),
+      v_impact_(sustained_contact_speed(m, adaptive.threshold_step > 0.0 ? adaptive.threshold_step : h)),
       touch_tol_(1e-7 * m.bounding_radius),
       max_sink_(m.curved() ? 0.0 : max_sink) {
   if (threshold == ImpactThreshold::Contact) {
@@ -62,6 +66,11 @@ int FixedStepper::step(RigidState& s) { return step(s, kinetic_energy(*m_, s)); 
 
 int FixedStepper::step(RigidState& s, double ke) {
   const DieModel& m = *m_;
+  if (kick_carry_ > 0.0) {  // the last step's closing half kick, before this one's impact
+    s.velocity.z() -= kick_g_ * kick_carry_;
+    kick_carry_ = 0.0;
+    ke = kinetic_energy(m, s);
+  }
   ContactSet c;
   if (s.position.z() <= m.bounding_radius + touch_tol_ && !(soa_vertices_ > 0 && soa_touching(s, c)))
     c = touching_corners(m, s, touch_tol_);
@@ -103,7 +112,7 @@ int FixedStepper::step(RigidState& s, double ke) {
   a_down_ = 0.0;
   start_shallow_ = start_depth_max_ = 0.0;
   hold_ = max_sink_ > 0.0 && c.n > 0;
-  h_ = hold_ ? predicted_step(s0, c) : h_max_;
+  h_ = hold_ ? predicted_step(s0, c) : h_ctrl_;
   if (hold_) {
     const Vec3 z_row = s0.R.row(2).transpose();
     double shallow = std::numeric_limits<double>::infinity();
@@ -452,6 +461,7 @@ int FixedStepper::step(RigidState& s, double ke) {
     warm_.P[i] = a.next.P[i];
   }
   dt_ = dt;
+  if (adaptive_.tol > 0.0) adapt(s0, s, dt);
   slap_located_ = rims_new_ && dt < h_;
   if (slap_rims_ != 0 && dt < h_) ++slaps;
   end_ke_ = kinetic_energy(m, s);

@@ -52,6 +52,24 @@ inline double sustained_contact_speed(const DieModel& m, double h) { return 4.0 
 // that depth is within this bound (FixedStepper's max_sink): 1e-4 of the bounding radius.
 inline double held_corner_sink(const DieModel& m) { return 1e-4 * m.bounding_radius; }
 
+// `impulse`'s sustained phase (tol > 0): leapfrog steps whose length an error estimate chooses.
+// Gravity is kicked in halves, one at each end of a step (the kick at a step's end and the next
+// one's start are applied together, before that step's impact and support solve), so the free
+// motion between the solves is second order (the half kick still owed when the phase ends is
+// given then: finish_phase). After each step, the contact's mean force and torque over it are
+// compared with the previous step's; the change, times (h^2 / 2) / m and (h^2 / 2) r / I_min, is
+// the position error of a body point that a step of length h makes where the contact force
+// changes (a corner lifting, sliding turning to sticking): the next step is the length at which
+// that estimate is tol r, within [floor, h] and at most double the last (a quarter at least).
+// tol = 0: fixed steps of h (first order), as `stepped`.
+// The impact threshold is then 4 g threshold_step, a fixed speed (the shape's default contact step,
+// DieModel::sustained_step), not 4 g h: the ceiling h may change without changing the physics.
+struct AdaptiveSteps {
+  double tol = 0.0;             // relative to the bounding radius (sim.contact_tol)
+  double floor = 0.0;           // the shortest step the estimate may ask for (s; located steps may be shorter)
+  double threshold_step = 0.0;  // s; 0: h
+};
+
 class FixedStepper {
  public:
   // max_sink > 0 (a flat-faced die only): each step with contact is shortened from h, down to
@@ -59,7 +77,7 @@ class FixedStepper {
   // floor: predicted from their acceleration at the start, checked on the accepted step (and the
   // step tried again shorter if deeper). 0: every step is h (the thresholds use h either way).
   FixedStepper(const DieModel& m, double h, ImpactThreshold threshold = ImpactThreshold::Gravity,
-               double max_sink = 0.0);
+               double max_sink = 0.0, const AdaptiveSteps& adaptive = {});
   static constexpr double kMinStepDivisor = 8.0;
 
   // Advances s by one step: h (or the step max_sink allows), or less if a new corner reaches the
@@ -84,6 +102,12 @@ class FixedStepper {
   long long coast(RigidState& s, double& t, double max_time, long long max_k) const;
 
   double h() const { return h_max_; }
+  // Adaptive steps: the half kick owed at the end of the last step (s.velocity.z() -= g times it),
+  // applied and cleared; the length the next step will have (before location or max_sink).
+  void finish_phase(RigidState& s);
+  std::uint64_t adapted = 0;      // adaptive: steps whose estimate asked for a shorter next step
+  double step_sum = 0.0;          // adaptive: the accepted steps' total length (mean step = step_sum / steps)
+  double next_step() const { return h_ctrl_; }
   double last_dt() const { return dt_; }
   int impacts = 0;                // steps whose contact solve had restitution
   Corrections corrections;        // of every solve and step so far
@@ -142,6 +166,9 @@ class FixedStepper {
   std::uint64_t rise_dropped = 0;        // flat dice, max_sink: steps whose held corners' rise would gain energy (plain)
 
  private:
+  // Adaptive: the closing half kick owed, and the next step's length from this step's mean contact
+  // force and torque against the last step's (AdaptiveSteps). s0: the step's start after its impact.
+  void adapt(const RigidState& s0, const RigidState& s, double dt);
   // The longest step (<= h_max_) whose held corners, moving with the die's free rotation from the
   // step's start, sink no more than max_sink_ below the floor within it (to second order in d;
   // what try_step's rise does not hold); sets a_down_.
@@ -208,7 +235,7 @@ class FixedStepper {
   // the smaller gravity kick of a step of length t changes, g (h - t) t. Exact for a step without
   // contact (the rotation is the same); with contact the solve absorbs part of the kick.
   double model_G(const ContactSet& c, double t) const {
-    return lowest_new(c, full_p_, full_v_, *full_rot_, t) + m_->gravity * (h_ - t) * t;
+    return lowest_new(c, full_p_, full_v_, *full_rot_, t) + kick_g_ * (h_ - t) * t;
   }
   // The model corrected by a trial's miss: model_G(t) + (miss + miss_rate_ t) t (h - t) (the model
   // is exact at t = 0, the step's start, and at t = h, the full step itself; miss_rate_, 0 unless
@@ -264,7 +291,13 @@ class FixedStepper {
   // ascending order, into c (as a fresh ContactSet). False if more than kMaxContacts touch (c
   // then partly filled: the caller takes touching_corners).
   bool soa_touching(const RigidState& s, ContactSet& c) const;
-  double h_max_;  // the contact step h (thresholds, coast)
+  double h_max_;  // the contact step h (thresholds, coast; adaptive: the ceiling)
+  AdaptiveSteps adaptive_;
+  double h_ctrl_;            // adaptive: the next step's length from the error estimate (else h_max_)
+  double kick_g_;            // the kick per unit step length before a step's solve: g (fixed steps) or g / 2
+  double kick_carry_ = 0.0;  // adaptive: the step length whose half kick is owed (the last step's)
+  bool have_force_ = false;  // adaptive: force_/torque_ hold the last step's mean contact force
+  Vec3 force_ = Vec3::Zero(), torque_ = Vec3::Zero();
   double h_;      // the current step's full length (h_max_, or shorter for max_sink_)
   double v_impact_, touch_tol_;
   double max_sink_ = 0.0;
@@ -372,6 +405,8 @@ struct StepperStats {
   std::uint64_t sink_shortened = 0;
   std::uint64_t short_steps = 0;
   std::uint64_t rise_dropped = 0;  // `impulse`: steps whose held corners' rise was dropped (it would gain energy)
+  std::uint64_t adapted = 0;       // adaptive: steps whose error estimate shortened the next one
+  double step_sum = 0.0;           // adaptive: total length of the accepted steps (s)
 };
 
 // Steps from (s, t) until the die must come to rest (sim/rest.hpp), the time cap, the impact cap
@@ -379,8 +414,9 @@ struct StepperStats {
 // steps (the caller's exact flight takes over). A die at rest in an exact unstable balance (on an
 // edge or corner) gets an infinitesimal spin whose direction comes from `tiebreak`. `stats`, if
 // given, accumulates the corrections, sweeps and energy check of the steps.
+// adaptive.tol > 0: `impulse`'s leapfrog steps of error-controlled length, h their ceiling.
 StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int& impacts, double h, double tiebreak,
                                bool allow_liftoff, ImpactThreshold threshold = ImpactThreshold::Gravity,
-                               StepperStats* stats = nullptr, double max_sink = 0.0);
+                               StepperStats* stats = nullptr, double max_sink = 0.0, const AdaptiveSteps& adaptive = {});
 
 }  // namespace dicesim

@@ -13,20 +13,23 @@
 namespace dicesim {
 
 StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int& impacts, double h, double tiebreak,
-                               bool allow_liftoff, ImpactThreshold threshold, StepperStats* stats, double max_sink) {
+                               bool allow_liftoff, ImpactThreshold threshold, StepperStats* stats, double max_sink,
+                               const AdaptiveSteps& adaptive) {
   StepperOutcome out;
-  FixedStepper st(m, h, threshold, max_sink);
+  FixedStepper st(m, h, threshold, max_sink, adaptive);
   st.impacts = impacts;
   const double g = m.gravity, r = m.bounding_radius;
   const double ke_rest = 1e-14 * m.mass * g * r;
   const double nudge = 1e-4 * std::sqrt(g / r);
   // Steps shortened to a new contact make more steps than (max_time - t) / h: a generous cap on
   // the count as well, so that nothing can loop forever.
-  const double h_min = max_sink > 0.0 ? h / FixedStepper::kMinStepDivisor : h;
+  double h_min = max_sink > 0.0 ? h / FixedStepper::kMinStepDivisor : h;
+  if (adaptive.tol > 0.0 && adaptive.floor > 0.0) h_min = std::min(h_min, adaptive.floor);
   const auto max_steps = 4 * static_cast<long long>(std::ceil((m.max_time - t) / h_min)) + 1000;
   std::uint64_t steps = 0;
   const auto finish = [&](StepperExit exit) {
     out.exit = exit;
+    st.finish_phase(s);  // adaptive: the half kick still owed (a lift-off's flight starts from the true velocity)
     impacts = st.impacts;
     if (stats) {
       stats->corrections.add(st.corrections);
@@ -59,6 +62,8 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->sink_shortened += st.sink_shortened;
       stats->short_steps += st.short_steps;
       stats->rise_dropped += st.rise_dropped;
+      stats->adapted += st.adapted;
+      stats->step_sum += st.step_sum;
       // The guards of the sustained phase, reported with the corrections (kept out of the
       // stepper's own, whose totals decide its re-tried steps).
       stats->corrections.located_capped += static_cast<std::uint32_t>(st.located_capped);

@@ -32,7 +32,10 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
     try_step_with(s0, c, d, a, full, 0.0);
     return;
   }
-  const double b = std::min(start_shallow_ / d + 0.5 * a_down_ * d, m.gravity * d);
+  // Adaptive steps: the depth is taken out over the ceiling's length at least (a short step asked
+  // to close it alone would rise fast, and gain energy).
+  const double span = adaptive_.tol > 0.0 ? std::max(d, h_max_) : d;
+  const double b = std::min(start_shallow_ / span + 0.5 * a_down_ * d, m.gravity * d);
   if (try_step_with(s0, c, d, a, full, b)) {
     if (full) full_bias_ = b;
     return;
@@ -59,7 +62,7 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   a.unreflected = false;
   a.risen = bias > 0.0;
   a.rise_dropped = false;
-  s.velocity.z() -= m.gravity * d;
+  s.velocity.z() -= kick_g_ * d;
   // Built in place (the full step's is kept for model_G; the object is large, so no copies). A
   // curved die's support solve builds its own (rim_support: the rotation is part of its search).
   std::optional<TorqueFreeRotation>& slot = full ? full_rot_ : trial_rot_;
@@ -124,9 +127,9 @@ double FixedStepper::predicted_step(const RigidState& s0, const ContactSet& c) {
     a_min = std::min(a_min, (w.cross(w.cross(r)) + alpha.cross(r)).z());
   }
   a_down_ = -a_min;
-  if (!(a_min < 0.0)) return h_max_;
+  if (!(a_min < 0.0)) return h_ctrl_;
   const double d = std::sqrt(2.0 * max_sink_ / -a_min);
-  return std::clamp(d, h_max_ / kMinStepDivisor, h_max_);
+  return std::clamp(d, std::min(h_ctrl_, h_max_ / kMinStepDivisor), h_ctrl_);
 }
 
 double FixedStepper::held_energy(const RigidState& s, const ContactSet& c) const {

@@ -165,6 +165,8 @@ void find_alike_outcomes(DieModel& m, const Body& body, const SceneDef& scene) {
 void finish_model(DieModel& m, const SceneDef& scene, const std::string& origin) {
   m.gravity = scene.sim.gravity;
   m.step = scene.sim.step;
+  m.sustained_step = m.curved() ? kContactStepCurved : kContactStepPolyhedron;
+  m.contact_tol = scene.sim.contact_tol;
   m.contact_step = scene.sim.contact_step > 0.0 ? scene.sim.contact_step
                    : m.curved()                 ? kContactStepCurved
                                                 : kContactStepPolyhedron;

@@ -11,6 +11,7 @@
 #include "sim/models/fidelity_models.hpp"
 #include "sim/dynamics/friction_impact.hpp"
 #include "sim/dynamics/rest.hpp"
+#include "sim/scene/scene.hpp"
 
 namespace dicesim {
 
@@ -18,7 +19,16 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
   TossResult r;
   double t = 0.0;
   const double set_tol = 1e-6 * m.bounding_radius;  // corners this close strike together
-  const double v_sustained = sustained_contact_speed(m, m.contact_step);
+  // A polyhedron's sustained contact: leapfrog steps of error-controlled length (contact_tol), the
+  // contact step their ceiling, and the impact threshold a fixed speed (the shape's default step),
+  // whatever the ceiling. A curved die keeps fixed first-order steps of contact_step (its rim
+  // support's energy argument assumes the whole kick before the solve: with half kicks the quarter
+  // on a table clamped millions of times), and its threshold 4 g contact_step.
+  const bool adaptive_steps = !m.curved() && m.contact_tol > 0.0;
+  const double v_sustained = sustained_contact_speed(m, adaptive_steps ? m.sustained_step : m.contact_step);
+  const AdaptiveSteps adaptive{.tol = adaptive_steps ? m.contact_tol : 0.0,
+                               .floor = std::min(kContactStepFloor, m.contact_step),
+                               .threshold_step = adaptive_steps ? m.sustained_step : 0.0};
   bool sustained = false;
   bool after_impact = false;  // the state is right after an impact (sustained contact is possible)
   StepperStats stats;
@@ -39,7 +49,7 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
       const PhaseTimer timer(probe, Phase::Steps);
       const StepperOutcome o =
           run_fixed_steps(m, s, t, r.bounces, m.contact_step, tiebreak, /*allow_liftoff=*/true, ImpactThreshold::Gravity, &stats,
-                          held_corner_sink(m));
+                          held_corner_sink(m), adaptive);
       if (o.exit == StepperExit::Settled) return settle(o.face_down);
       if (o.exit == StepperExit::Unresolved) break;
       sustained = false;  // lift-off: back to exact flight

@@ -140,6 +140,7 @@ constexpr Range kGravity{.lo = 0, .hi = 1000, .lo_open = true, .unit = "m/s^2"};
 constexpr Range kStopSpeed{.lo = 0, .hi = 100, .unit = "m/s"};
 constexpr Range kMaxTime{.lo = 0, .hi = 1e6, .lo_open = true, .unit = "s"};
 constexpr Range kStep{.lo = 1e-7, .hi = 1e-2, .unit = "s"};
+constexpr Range kContactTol{.lo = 0.0, .hi = 1e-2, .unit = ""};
 constexpr Range kAnyNumber{};
 
 // Names a key may take, and what each means.
@@ -555,6 +556,7 @@ void read_sim(Reader sim, SimDef& def) {
   def.max_time = sim.number("max_time", kMaxTime, def.max_time);
   def.step = sim.number("step", kStep, def.step);
   def.contact_step = sim.number("contact_step", kStep, def.contact_step);
+  def.contact_tol = sim.number("contact_tol", kContactTol, def.contact_tol);
   if (sim.get("end")) def.end = sim.choice("end", kEndKinds, def.end).second;
   sim.finish();
 }
@@ -862,6 +864,7 @@ std::string key_unit(std::string_view key) {
       {"sim.max_time", &kMaxTime},
       {"sim.step", &kStep},
       {"sim.contact_step", &kStep},
+      {"sim.contact_tol", &kContactTol},
   };
   for (const auto& [name, range] : units)
     if (k == name) return range->unit;
