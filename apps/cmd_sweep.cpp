@@ -158,9 +158,10 @@ void write_plot(const std::string& path, const SweepSpec& spec, const SweepResul
   std::uint64_t lost = 0;
   for (const SweepPointResult& r : res.points) lost += r.counts.unresolved + r.counts.invalid;
   const std::string fidelity = res.points.empty() ? "" : res.points[0].fidelity;
+  // Three lines: one would run past the picture's width (clipped at both ends).
   gp << "set title " << gnuplot_quote(title + "\n" + spec.scene + ", fidelity " + fidelity + ", " +
                                      std::to_string(spec.tosses) + " tosses per point (seed " + std::to_string(spec.seed) +
-                                     ", the same at every point); bands: 95% Wilson" +
+                                     ", the same at every point)\nbands: 95% Wilson" +
                                      (lost == 0 ? "; every toss settled" : ""))
      << " noenhanced\n";
   gp << "set xlabel " << gnuplot_quote(pl.x_label) << " noenhanced\n";

@@ -108,16 +108,23 @@ int plot_tradeoff_csv(const std::string& csv, const std::string& png, const std:
       "set terminal pngcairo size 1000,620 noenhanced\n"
       "set output '" + png + "'\n"
       "set datafile separator ','\n"
-      "set title '" + title + "'\n"
+      "set title '" + title + " (point labels: the setting of each row)'\n"
       "set logscale xy\n"
       "set xlabel 'tosses per second'\n"
       "set ylabel 'distance from the reference (stepped, finest step)'\n"
-      "set key inside left bottom box opaque\n"
+      "set key at graph 0.02, graph 0.76 left top box opaque font ',9' title 'distance from the reference'\n"
       "set grid\nset yrange [1e-3:2]\n"
-      "plot '" + csv + "' skip 1 using 3:(column(5) > 0 ? column(5) : 1/0):(sprintf('%s %s', strcol(1), strcol(2))) "
-      "with labels point pt 7 ps 1.2 offset char 1,0.6 font ',8' title 'total variation vs reference', "
-      "'' skip 1 using 3:6 with points pt 6 ps 1.5 title 'noise level of the total variation', "
-      "'' skip 1 using 3:(1 - column(4) > 0 ? 1 - column(4) : 1/0) with points pt 5 ps 1 title '1 - same face fraction'\n";
+      // One colour per fidelity (its rows are a ladder of one setting); each point labelled by its
+      // setting's value only, turned, so that the close ladders of impulse and stepped stay legible.
+      "val(s) = strstrt(s, '=') > 0 ? s[strstrt(s, '=') + 1:] : ''\n"
+      "tv(f) = (strcol(1) eq f && column(5) > 0) ? column(5) : 1/0\n"
+      "plot for [f in 'static paper impulse stepped'] '" + csv + "' skip 1 using 3:(tv(f)) with points pt 7 ps 1.3 "
+      "title f, "
+      "'' skip 1 using 3:(column(5) > 0 ? column(5) : 1/0):(val(strcol(2))) with labels rotate by 35 left "
+      "offset char 0.6,0.5 font ',8' notitle, "
+      "'' skip 1 using 3:6 with points pt 6 ps 1.5 lc rgb 'gray40' title 'noise level of the total variation', "
+      "'' skip 1 using 3:(1 - column(4) > 0 ? 1 - column(4) : 1/0) with points pt 5 ps 0.8 lc rgb 'gray70' "
+      "title '1 - same face fraction'\n";
   std::FILE* gp = popen("gnuplot", "w");
   if (!gp) return kExitFailed;
   std::fputs(script.c_str(), gp);

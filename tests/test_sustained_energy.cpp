@@ -65,4 +65,39 @@ TEST(SustainedEnergy, NoStepRaisesPlainEnergyBeyondTheHeldDepth) {
   }
 }
 
+// The same promise for the leapfrog steps of error-controlled length (sim.contact_tol, polyhedra
+// in `impulse`), each step's true energies compared (the start's after the closing half kick, the
+// end's with its own still owed). NOT MET (why sim.contact_tol is experimental and off): measured
+// 2026-11-29 (lead), 485 of these 1 080 tosses have a step whose plain energy rises beyond the held
+// depth, by up to 8.8e-4 r (Die 1, d20, fair, d4; worst at e = 0). With half kicks the support
+// solve's impulse does work against the owed half kick ((g d / 2) P_z), which the fixed step's
+// argument (the whole kick before the solve) does not cover.
+TEST(SustainedEnergy, DISABLED_LeapfrogStepsRaisePlainEnergyNoMoreThanTheHeldDepth) {
+  std::uint64_t steps = 0;
+  for (const char* scene : {"scenes/paper/die1.toml", "scenes/fair.toml", "scenes/dice/d20.toml", "scenes/dice/d4.toml"}) {
+    for (double e : {0.0, 0.5, 1.0}) {
+      for (double mu : {0.0, 0.3, 2.0}) {
+        SceneDef def = load_scene(std::string(DICESIM_SOURCE_DIR) + "/" + scene);
+        def.sim.fidelity = Fidelity::Impulse;
+        def.sim.contact_tol = 1e-4;
+        def.floor.restitution = e;
+        def.floor.friction = mu;
+        def.sim.max_time = 4.0;
+        const DieModel m = compile(def);
+        for (int i = 0; i < 30; ++i) {
+          TossProbe probe;
+          toss(m, 39, static_cast<std::uint64_t>(i), &probe);
+          steps += probe.steps;
+          const std::string what = std::string(scene) + " e " + std::to_string(e) + " mu " + std::to_string(mu) +
+                                   " toss " + std::to_string(i);
+          EXPECT_LE(probe.max_rise_excess, 1e-12) << what;
+          const double bound = std::max(probe.max_held_sink, 1e-7 * m.bounding_radius) + 1e-12 * 4.0;
+          EXPECT_LE(probe.max_step_rise, bound) << what << " rise/r " << probe.max_step_rise / m.bounding_radius;
+        }
+      }
+    }
+  }
+  EXPECT_GT(steps, 0u);
+}
+
 }  // namespace

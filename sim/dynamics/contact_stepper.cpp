@@ -465,18 +465,26 @@ int FixedStepper::step(RigidState& s, double ke) {
   slap_located_ = rims_new_ && dt < h_;
   if (slap_rims_ != 0 && dt < h_) ++slaps;
   end_ke_ = kinetic_energy(m, s);
+  // The energy checks below compare true energies: a leapfrog step ends with its closing half
+  // kick still owed (adapt() set it), which the start's energy already had.
+  double ke_end = end_ke_;
+  if (kick_carry_ > 0.0) {
+    RigidState end = s;
+    end.velocity.z() -= kick_g_ * kick_carry_;
+    ke_end = kinetic_energy(m, end);
+  }
   if (a.risen) {
     // A step whose held corners rose: no gain in the rest rules' energy, which adds the deepest
     // corner's depth to the COM height (try_step's check).
     max_energy_gain =
         std::max(max_energy_gain, relative_gain(E0 + m.mass * m.gravity * start_depth_max_, a.held_e));
   } else {
-    max_energy_gain = std::max(max_energy_gain, relative_gain(E0, end_ke_ + m.mass * m.gravity * s.position.z()));
+    max_energy_gain = std::max(max_energy_gain, relative_gain(E0, ke_end + m.mass * m.gravity * s.position.z()));
   }
   {
     // Plain E over the step (the lifts below are counted corrections, not the step's).
     const double mg = m.mass * m.gravity;
-    const double plain = end_ke_ + mg * s.position.z();
+    const double plain = ke_end + mg * s.position.z();
     max_step_rise = std::max(max_step_rise, (plain - E0) / mg);
     max_rise_excess = std::max(max_rise_excess, relative_gain(E0 + mg * start_depth_max_, plain));
   }

@@ -169,6 +169,7 @@ class FixedStepper {
   // Adaptive: the closing half kick owed, and the next step's length from this step's mean contact
   // force and torque against the last step's (AdaptiveSteps). s0: the step's start after its impact.
   void adapt(const RigidState& s0, const RigidState& s, double dt);
+  bool kick_carry_owed() const { return adaptive_.tol > 0.0; }  // leapfrog: every step ends owing a half kick
   // The longest step (<= h_max_) whose held corners, moving with the die's free rotation from the
   // step's start, sink no more than max_sink_ below the floor within it (to second order in d;
   // what try_step's rise does not hold); sets a_down_.

@@ -107,7 +107,15 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   s.position = p + d * v;
   if (!(bias > 0.0)) return true;
   // (New corners below the floor are the located step's business.)
-  a.held_e = held_energy(s, c);
+  // Adaptive (leapfrog): s's velocity is the step's middle one; the energy at its end, comparable
+  // with the start's (the true velocity, after the closing half kick), has that kick too.
+  if (kick_carry_owed()) {
+    RigidState end = s;
+    end.velocity.z() -= kick_g_ * d;
+    a.held_e = held_energy(end, c);
+  } else {
+    a.held_e = held_energy(s, c);
+  }
   return a.held_e <= e_start_ + m.mass * m.gravity * start_depth_max_;
 }
 
