@@ -100,6 +100,13 @@ SessionResult run_session(const SessionOptions& opt, const AggregatorConfig& cfg
   }
   res.elapsed_s = seconds_since(t0);
   res.run_elapsed_s = elapsed_before + res.elapsed_s;
+  if (res.end == SessionEnd::Finished && opt.url.rfind("tcpq://", 0) == 0) {
+    // Over a TCP hub the final answers are bytes on our socket: closing it with workers' batches
+    // still unread makes the kernel reset the connection, and the hub may never relay them (a
+    // listener then never hears the run finish). Keep reading a moment first, so they go out.
+    const double until = seconds_since(t0) + 0.3;
+    while (seconds_since(t0) < until) wire::handle_timeout(bus, 10);
+  }
   if (writer) {
     // The last state (finished, interrupted or failed), so that --resume continues from here.
     take_checkpoint(res.elapsed_s);

@@ -7,6 +7,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "messages/lcm_wait.hpp"
 #include "apps/commands.hpp"
 #include "messages/wire.hpp"
 #include "sim/scene/scene_error.hpp"
@@ -55,7 +56,7 @@ int serve(const ServeArgs& a) {
                url.c_str());
   const auto t0 = std::chrono::steady_clock::now();
   while (!g_stop) {
-    bus.handleTimeout(100);
+    wire::listen_timeout(bus, 100);
     if (a.timeout_s > 0 && std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > a.timeout_s) break;
   }
   server.stop();

@@ -8,6 +8,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "messages/lcm_wait.hpp"
 #include "apps/commands.hpp"
 #include "messages/auth.hpp"
 #include "messages/wire.hpp"
@@ -91,7 +92,7 @@ int watch(const WatchArgs& a) {
                a.run != 0 ? ("run " + std::to_string(a.run)).c_str() : "any run");
   const auto t0 = std::chrono::steady_clock::now();
   while (!g_stop && !(a.until_finished && printer.finished)) {
-    bus.handleTimeout(100);
+    wire::listen_timeout(bus, 100);
     const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (a.timeout_s > 0 && t > a.timeout_s) {
       std::fprintf(stderr, "dicesim: failed: %s after %g s\n", a.until_finished ? "no run finished" : "timed out",

@@ -13,6 +13,7 @@
 #include "bridge/translate.hpp"
 #include "messages/auth.hpp"
 #include "messages/wire.hpp"
+#include "messages/lcm_wait.hpp"
 
 namespace dicesim::bridge {
 namespace {
@@ -99,7 +100,7 @@ BridgeStats run_bridge(const BridgeDef& def) {
 
   double last_tick = -1.0;
   while (!(def.stop && def.stop->load())) {
-    if (bus.handleTimeout(50) < 0) {
+    if (wire::listen_timeout(bus, 50) < 0) {
       // A signal interrupts the wait: that is how we are asked to stop, not a failure.
       if (errno == EINTR) continue;
       throw std::runtime_error("LCM receive failed on '" + def.lcm_url + "': " + std::strerror(errno));

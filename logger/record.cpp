@@ -9,6 +9,7 @@
 #include "logger/log.hpp"
 #include "messages/auth.hpp"
 #include "messages/wire.hpp"
+#include "messages/lcm_wait.hpp"
 
 namespace dicesim::eventlog {
 namespace {
@@ -101,10 +102,10 @@ RecordResult record(const RecordOptions& opt) {
       res.end = RecordEnd::TimedOut;
       break;
     }
-    bus.handleTimeout(20);
+    wire::listen_timeout(bus, 20);
   }
   // Whatever is already queued was received before the stop: keep it.
-  while (!rec.write_failed && bus.handleTimeout(0) > 0) {
+  while (!rec.write_failed && wire::listen_timeout(bus, 0) > 0) {
   }
   if (!out.flush() && res.error.empty()) {
     res.error = "cannot write '" + opt.path + "' (disk full?)";

@@ -21,4 +21,18 @@ inline int handle_timeout(lcm::LCM& bus, int ms) {
   return bus.handleTimeout(ms);
 }
 
+// The same for a process that only listens (watch, record, bridge, serve): it never publishes, so
+// nothing would reconnect it after a lost hub. While the connection is down it publishes an empty
+// message on kReconnectChannel, which no dicesim process listens to (outside DICESIM_*: loggers do
+// not record it): that publish reconnects, and the provider subscribes every channel again.
+inline constexpr const char* kReconnectChannel = "dicesim_reconnect";
+inline int listen_timeout(lcm::LCM& bus, int ms) {
+  if (bus.getFileno() < 0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(ms > 0 ? ms : 1));
+    bus.publish(kReconnectChannel, "", 0);
+    return 0;
+  }
+  return bus.handleTimeout(ms);
+}
+
 }  // namespace dicesim::wire

@@ -15,7 +15,9 @@ struct CorrectionCounts {
   Count energy_clamps = 0;    // an impact would have gained energy and was scaled back
   Count pgs_unconverged = 0;  // a multi-contact solve converged neither by Gauss-Seidel nor by its Newton finish
   Count overlap_fixes = 0;    // the stepper lifted the die out of the floor
-  Count fallbacks = 0;        // an exact solve failed (jam) or a frictionless rescue ran
+  Count fallbacks = 0;        // a frictionless rescue pass ran (a corner still approaching after the
+                              // frictional solve), or corners beyond kMaxContacts got no impulse; an exact
+                              // solve's jam is not one (ImpactResult::exact_fallbacks, reported by bench)
   // The sustained phase's guards (contact_stepper.cpp):
   Count located_capped = 0;          // a new contact not located within the touch tolerance in the trials allowed
   Count support_search_capped = 0;   // curved dice: a support search out of iterations (its end above the floor taken)

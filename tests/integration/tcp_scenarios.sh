@@ -7,7 +7,8 @@
 #   three_workers  three workers and an aggregator through the hub: toss's counts
 #   kill9          a worker killed (SIGKILL) mid-run: the same counts
 #   hub_restart    the hub killed mid-run and restarted on its port: LCM's tcpq clients reconnect,
-#                  the run finishes with the same counts
+#                  the run finishes with the same counts, and a `dicesim watch` (which only
+#                  listens) reconnects too and sees it finish
 #   key            an authenticated run (--key-file) over TCP: the same counts, and a worker with
 #                  another key's messages are all dropped (it tosses nothing that counts)
 #   run_tcp        dicesim run --transport tcp --workers 2 (a hub of its own): the same counts
@@ -113,6 +114,9 @@ case "$scenario" in
     hub
     worker; worker
     listening 2
+    # A process that only listens (watch) follows the run across the restart too: it reconnects by
+    # itself (wire::listen_timeout), prints the finished answer and its provenance.
+    "$bin" watch --until-finished --timeout 150 > "$work/watch.out" 2> "$work/watch.err" & watchp=$!; pids+=($watchp)
     aggregate & agg=$!
     "$inject" progress 0.1 120 || fail "the run never reached 10%, or finished before the hub was killed"
     kill -9 "$hubpid"; wait "$hubpid" 2> /dev/null || true
@@ -120,6 +124,9 @@ case "$scenario" in
     hub
     wait "$agg" || fail "aggregate exited $? after the hub's restart"
     same_as_reference "$work/out.json"
+    wait "$watchp" || fail "dicesim watch exited $? across the hub's restart (it did not reconnect)"
+    grep -q "FINISHED $n/$n" "$work/watch.out" || fail "dicesim watch did not see the run finish after the hub's restart"
+    grep -q "provenance: " "$work/watch.out" || fail "dicesim watch printed no provenance for the finished run"
     ;;
   key)
     n=150000
