@@ -27,12 +27,8 @@ inline int handle_timeout(lcm::LCM& bus, int ms) {
 // not record it): that publish reconnects, and the provider subscribes every channel again.
 inline constexpr const char* kReconnectChannel = "dicesim_reconnect";
 inline int listen_timeout(lcm::LCM& bus, int ms) {
-  if (bus.getFileno() < 0) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(ms > 0 ? ms : 1));
-    bus.publish(kReconnectChannel, "", 0);
-    return 0;
-  }
-  return bus.handleTimeout(ms);
+  if (bus.getFileno() < 0) bus.publish(kReconnectChannel, "", 0);  // reconnects if the hub is back
+  return handle_timeout(bus, ms);
 }
 
 }  // namespace dicesim::wire

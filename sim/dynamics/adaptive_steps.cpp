@@ -11,7 +11,6 @@ namespace dicesim {
 void FixedStepper::adapt(const RigidState& s0, const RigidState& s, double dt) {
   const DieModel& m = *m_;
   kick_carry_ = dt;
-  step_sum += dt;
   if (!(dt > 0.0)) return;
   // What changed the momenta over the step besides the half kick before its solve: the contact.
   const Vec3 F = m.mass * ((s.velocity - s0.velocity) / dt + Vec3(0.0, 0.0, kick_g_));
@@ -22,7 +21,6 @@ void FixedStepper::adapt(const RigidState& s0, const RigidState& s, double dt) {
     // A step of length h errs by about h^2 jump / 2 at a body point where the force changes so.
     const double want = jump > 0.0 ? 0.9 * std::sqrt(2.0 * adaptive_.tol * r / jump) : h_max_;
     const double next = std::clamp(want, std::max(adaptive_.floor, 0.25 * h_ctrl_), std::min(h_max_, 2.0 * h_ctrl_));
-    if (next < h_ctrl_) ++adapted;
     h_ctrl_ = next;
   }
   force_ = F;

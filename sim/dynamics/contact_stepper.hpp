@@ -105,8 +105,6 @@ class FixedStepper {
   // Adaptive steps: the half kick owed at the end of the last step (s.velocity.z() -= g times it),
   // applied and cleared; the length the next step will have (before location or max_sink).
   void finish_phase(RigidState& s);
-  std::uint64_t adapted = 0;      // adaptive: steps whose estimate asked for a shorter next step
-  double step_sum = 0.0;          // adaptive: the accepted steps' total length (mean step = step_sum / steps)
   double next_step() const { return h_ctrl_; }
   double last_dt() const { return dt_; }
   int impacts = 0;                // steps whose contact solve had restitution
@@ -406,8 +404,6 @@ struct StepperStats {
   std::uint64_t sink_shortened = 0;
   std::uint64_t short_steps = 0;
   std::uint64_t rise_dropped = 0;  // `impulse`: steps whose held corners' rise was dropped (it would gain energy)
-  std::uint64_t adapted = 0;       // adaptive: steps whose error estimate shortened the next one
-  double step_sum = 0.0;           // adaptive: total length of the accepted steps (s)
 };
 
 // Steps from (s, t) until the die must come to rest (sim/rest.hpp), the time cap, the impact cap

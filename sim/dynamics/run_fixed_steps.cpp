@@ -62,8 +62,6 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->sink_shortened += st.sink_shortened;
       stats->short_steps += st.short_steps;
       stats->rise_dropped += st.rise_dropped;
-      stats->adapted += st.adapted;
-      stats->step_sum += st.step_sum;
       // The guards of the sustained phase, reported with the corrections (kept out of the
       // stepper's own, whose totals decide its re-tried steps).
       stats->corrections.located_capped += static_cast<std::uint32_t>(st.located_capped);

@@ -160,7 +160,7 @@ inline constexpr double kContactStepCurved = 1e-3;
 // step above is then the ceiling, kContactStepFloor the floor (located steps, which end at a new
 // contact's instant, may be shorter). 0 (the default): fixed first-order steps of the contact step.
 // Experimental, not the default: its steps do not keep the energy statement (a step's plain energy
-// rose up to 8.8e-4 r beyond the held depth), rise_dropped fires ~1 in 8 tosses, and on Die 1 it
+// rose up to 8.8e-4 r beyond the held depth), rise_dropped fires ~1 in 7 tosses, and on Die 1 it
 // leaves the face distribution where fixed 3 ms steps put it (2*10^4 tosses: at most 21 outcomes
 // differ) at 2.5x the cost (docs/fidelity.md, "Sustained contact"). Curved dice ignore it.
 inline constexpr double kContactTolDefault = 0.0;
