@@ -54,7 +54,7 @@ void write_profile_plot(const std::string& path, const FitResult& r) {
      << " noenhanced\n";
   // The legend below the axes: at the top centre it covered the profile's minimum.
   gp << "set grid\nset border 3\nset tics nomirror\nset ylabel '2 (l_max - l_profile)' noenhanced\n"
-        "set key below horizontal noenhanced\n";
+        "set key below horizontal Left reverse noenhanced\n";
   for (const FitParamResult& p : r.params) {
     const std::string unit = key_unit(p.key);
     gp << "set xlabel " << gnuplot_quote(unit.empty() ? p.key : p.key + " (" + unit + ")") << " noenhanced\n";
@@ -70,9 +70,13 @@ void write_profile_plot(const std::string& path, const FitResult& r) {
     gp << "$p << EOD\n";
     for (const auto& row : p.profile) gp << number_text(row[0]) << " " << number_text(row[1]) << "\n";
     gp << "EOD\n";
-    gp << "plot $p using 1:2 with lines lw 2 title 'profile', 3.841 with lines dt 3 title '95% cut (3.84)', "
-       << "'+' using (" << number_text(p.estimate) << "):(0) with points pt 7 ps 1.2 title "
-       << gnuplot_quote("estimate " + short_text(p.estimate)) << "\n";
+    // The legend says what the dashed bounds are: the interval's numbers, in the key's unit.
+    const std::string in_unit = unit.empty() ? "" : " " + unit;
+    gp << "plot $p using 1:2 with lines lw 2 title 'profile', 3.841 with lines dt 3 lw 1.5 lc rgb 'black' title "
+       << gnuplot_quote("95% interval [" + short_text(p.ci95.lo) + ", " + short_text(p.ci95.hi) + "]" + in_unit +
+                        " (cut 3.84)")
+       << ", '+' using (" << number_text(p.estimate) << "):(0) with points pt 7 ps 1.2 title "
+       << gnuplot_quote("estimate " + short_text(p.estimate) + in_unit) << "\n";
     gp << "unset arrow\n";
   }
   gp << "unset multiplot\n";

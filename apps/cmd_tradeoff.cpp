@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -14,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
+#include "apps/gnuplot.hpp"
 #include "apps/number_forms.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/study/agreement.hpp"
@@ -30,7 +32,7 @@ struct TradeoffArgs {
   std::uint64_t seed = 1;
   int threads = 1;
   bool json = false;
-  std::string csv, plot;
+  std::string csv, plot, from_csv;
   std::vector<double> steps = {2e-3, 1e-3, 5e-4, 2e-4};  // the last one is the reference
 };
 
@@ -102,17 +104,18 @@ void write_csv(std::FILE* out, const std::vector<Row>& rows) {
 
 }  // namespace
 
-// Exposed for scripts/plot-tradeoff's sake: the same gnuplot program from a CSV written above.
-int plot_tradeoff_csv(const std::string& csv, const std::string& png, const std::string& title) {
+// The gnuplot program drawing the rows of a CSV written above; throws std::runtime_error if gnuplot fails.
+void plot_tradeoff_csv(const std::string& csv, const std::string& png, const std::string& title) {
   const std::string script =
-      "set terminal pngcairo size 1000,620 noenhanced\n"
-      "set output '" + png + "'\n"
+      gnuplot_terminal(png, 1000, 620) +
       "set datafile separator ','\n"
-      "set title '" + title + " (point labels: the setting of each row)'\n"
+      // Centred on the picture (centred on the plot, its second line ran past the left edge).
+      "set tmargin 4\nset label 1 " + gnuplot_quote(title) + " at screen 0.5, screen 0.975 center front noenhanced\n"
       "set logscale xy\n"
-      "set xlabel 'tosses per second'\n"
+      "set xlabel 'tosses per second (all threads; depends on the machine and its load)'\nset format x '10^{%L}'\n"
       "set ylabel 'distance from the reference (stepped, finest step)'\n"
-      "set key at graph 0.02, graph 0.76 left top box opaque font ',9' title 'distance from the reference'\n"
+      // Below the axes: inside, at any fixed place, the rows of a slower machine ran under it.
+      "set key below horizontal Left reverse font ',9'\n"
       "set grid\nset yrange [1e-3:2]\n"
       // One colour per fidelity (its rows are a ladder of one setting); each point labelled by its
       // setting's value only, turned, so that the close ladders of impulse and stepped stay legible.
@@ -125,10 +128,7 @@ int plot_tradeoff_csv(const std::string& csv, const std::string& png, const std:
       "'' skip 1 using 3:6 with points pt 6 ps 1.5 lc rgb 'gray40' title 'noise level of the total variation', "
       "'' skip 1 using 3:(1 - column(4) > 0 ? 1 - column(4) : 1/0) with points pt 5 ps 0.8 lc rgb 'gray70' "
       "title '1 - same face fraction'\n";
-  std::FILE* gp = popen("gnuplot", "w");
-  if (!gp) return kExitFailed;
-  std::fputs(script.c_str(), gp);
-  return pclose(gp) == 0 ? kExitOk : kExitFailed;
+  run_gnuplot(script, png);
 }
 
 namespace {
@@ -136,6 +136,14 @@ namespace {
 int run_tradeoff(const TradeoffArgs& a) {
   const SceneDef base = a.scene.load();
   (void)compile(base, a.scene.path);  // bad scenes fail before any work
+  if (!a.from_csv.empty()) {  // redraw an earlier run's rows: no tossing
+    if (a.plot.empty()) throw SceneError("dicesim bench tradeoff", "--from-csv", a.from_csv, "needs --plot FILE.png");
+    if (!std::ifstream(a.from_csv)) throw SceneError("dicesim bench tradeoff", "--from-csv", a.from_csv, "a readable file");
+    plot_tradeoff_csv(a.from_csv, a.plot,
+                      a.scene.path + ": accuracy against speed\nrows from " + a.from_csv +
+                          "; point labels: each row's setting (a step in s; paper: its stop speed in m/s)");
+    return kExitOk;
+  }
   std::vector<Row> rows;
   const auto row = [](Setting s) {
     Row r;
@@ -205,13 +213,17 @@ int run_tradeoff(const TradeoffArgs& a) {
     if (!f) throw SceneError(a.plot, "--plot", a.plot, "cannot write next to this file");
     write_csv(f, rows);
     std::fclose(f);
-    const int rc = plot_tradeoff_csv(tmp, a.plot, a.scene.path + ": accuracy against speed");
-    std::remove(tmp.c_str());
-    if (rc != kExitOk) {
-      std::fprintf(stderr, "dicesim: failed: gnuplot could not draw %s (is gnuplot-nox installed? scripts/setup)\n",
-                   a.plot.c_str());
-      return kExitFailed;
+    const std::string title = a.scene.path + ": accuracy against speed\n" + std::to_string(a.tosses) +
+                              " tosses per row (the same indices in each, seed " + std::to_string(a.seed) + "), " +
+                              std::to_string(a.threads) + (a.threads == 1 ? " thread" : " threads") +
+                              "; point labels: each row's setting (a step in s; paper: its stop speed in m/s)";
+    try {
+      plot_tradeoff_csv(tmp, a.plot, title);
+    } catch (...) {
+      std::remove(tmp.c_str());
+      throw;
     }
+    std::remove(tmp.c_str());
   }
   return kExitOk;
 }
@@ -232,13 +244,26 @@ int run_bench_tradeoff(int argc, char** argv) {
   app.add_option("-j,--threads", a->threads, "Threads (tosses/s is for all of them together)")
       ->capture_default_str()
       ->check(CLI::Range(1, 1024));
-  app.add_option("--steps", a->steps, "Ladder of steps (s) for impulse's contact_step and stepped's step; the last "
-                                      "one is the reference")
+  // Commas as in sweep's --values (`--steps 1e-3,5e-4,2e-4`); spaces work too.
+  app.add_option("--steps", a->steps, "Ladder of steps (s) for impulse's contact_step and stepped's step, each in "
+                                      "[1e-7, 0.01], separated by commas or spaces; the last one is the reference")
       ->capture_default_str()
-      ->check(CLI::Range(1e-7, 1e-2));
+      ->delimiter(',')
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            char* end = nullptr;
+            const double x = std::strtod(v.c_str(), &end);
+            if (v.empty() || *end != '\0' || !(x >= 1e-7 && x <= 1e-2))
+              return "'" + v + "' is not a step: each is a number of seconds in [1e-7, 0.01], the list separated by "
+                               "commas or spaces (--steps 2e-3,1e-3,5e-4)";
+            return {};
+          },
+          "STEP", "step"));
   app.add_flag("--json", a->json, "One JSON object {scene, tosses, reference, rows} on stdout");
   app.add_option("--csv", a->csv, "Also write the rows as CSV to this file")->type_name("FILE");
   app.add_option("--plot", a->plot, "Also draw accuracy against speed as PNG (gnuplot)")->type_name("FILE.png");
+  app.add_option("--from-csv", a->from_csv, "Toss nothing: draw --plot from the rows of an earlier --csv")
+      ->type_name("ROWS.csv");
   int exit_code = kExitOk;
   app.callback([a, &exit_code] { exit_code = run_tradeoff(*a); });
   accept_number_forms(app);

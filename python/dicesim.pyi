@@ -144,7 +144,7 @@ def fit(
 def power(
     scene: SceneArg,
     *,
-    against: Optional[Scene] = None,
+    against: Optional[SceneArg] = None,
     detect_bias: Optional[float] = None,
     n: Count = 100000,
     alpha: float = 0.05,

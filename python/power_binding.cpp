@@ -19,17 +19,19 @@ std::string labels_text(const std::vector<int>& labels) {
   return t + "]";
 }
 
-pb::object do_power(const pb::object& scene_given, const std::shared_ptr<Scene>& against, std::optional<double> detect_bias,
+pb::object do_power(const pb::object& scene_given, const pb::object& against_given, std::optional<double> detect_bias,
                     const pb::object& n_given,
                     double alpha, double power, std::uint64_t replicates, int bootstrap, std::uint64_t seed, int threads,
                     std::optional<std::string> fidelity, const pb::object& progress) {
   const std::shared_ptr<Scene> held = scene_arg(scene_given);
   Scene& scene = *held;
+  // against, like scene, may be a path: power('die.toml', against='scenes/fair.toml').
+  const std::shared_ptr<Scene> against = against_given.is_none() ? nullptr : scene_arg(against_given);
   const std::optional<std::uint64_t> counted = count_arg(n_given, "n");
   if (!counted) throw pb::type_error("n must be a whole number, got None");
   const std::uint64_t n = *counted;
   if ((against != nullptr) == detect_bias.has_value())
-    throw pb::value_error("give exactly one of against (a Scene) or detect_bias (a shift in (0, 0.5])");
+    throw pb::value_error("give exactly one of against (a Scene or a path) or detect_bias (a shift in (0, 0.5])");
   if (!(alpha > 0.0 && alpha < 1.0)) throw pb::value_error("alpha must be in (0, 1), got " + std::to_string(alpha));
   if (!(power > alpha && power < 1.0))
     throw pb::value_error("power must be in (alpha, 1) = (" + std::to_string(alpha) + ", 1), got " + std::to_string(power));
@@ -119,8 +121,7 @@ void register_power(pb::module_& m) {
         "the tosses' own noise (a paired bootstrap of toss batches), 'n_exact_replicate_sd' its noise\n"
         "from the replicates. Everything is a function of seed, on any number of threads.\n"
         "Bad arguments raise ValueError; scenes with different outcome labels raise SceneError.\n\n"
-        "    d = dicesim.power(dicesim.load_scene('scenes/paper/die1.toml'),\n"
-        "                      against=dicesim.load_scene('scenes/fair.toml'))\n"
+        "    d = dicesim.power('scenes/paper/die1.toml', against='scenes/fair.toml')\n"
         "    d['n_exact'], d['n_range95']");
 }
 

@@ -85,3 +85,19 @@ TEST(CliFirstHour, TossHelpSaysWhichFidelity) {
                         "stepped  the reference", "paper    only to reproduce", "static   a die placed"})
     EXPECT_NE(help.find(f), std::string::npos) << f << "\n" << help;
 }
+
+// `--steps 2e-3,1e-3` was read as one value and refused with CLI11's "could not be converted":
+// commas separate the ladder as in sweep's --values (spaces too), and a bad entry is named with
+// what is accepted.
+TEST(CliFirstHour, TradeoffStepsTakeCommasAndSayWhatIsAccepted) {
+  for (const char* steps : {"2e-3,1e-3", "2e-3 1e-3"}) {
+    const CliRun r = cli(std::string("bench tradeoff scenes/fair.toml -n 20 --json --steps ") + steps);
+    ASSERT_EQ(r.code, 0) << steps << ": " << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["rows"].size(), 6u) << steps;  // static, paper, then impulse and stepped at each step
+    EXPECT_EQ(j["reference"]["setting"], "step=0.001") << steps;
+  }
+  expect_bad_input(cli("bench tradeoff scenes/fair.toml -n 20 --steps 2e-3,1e-3x"),
+                   {"--steps", "'1e-3x' is not a step", "[1e-7, 0.01]", "commas or spaces"});
+  expect_bad_input(cli("bench tradeoff scenes/fair.toml -n 20 --steps 2e-3,0.5"), {"'0.5' is not a step"});
+}

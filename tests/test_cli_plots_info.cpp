@@ -5,6 +5,7 @@
 
 #include "cli_runner.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -51,7 +52,12 @@ TEST(CliPlots, ASweepOfAKeyHasItsUnitTheRunAndTheReference) {
   EXPECT_TRUE(has(gp, "title \"face 1\"")) << gp;
   EXPECT_TRUE(has(gp, "0.1666") && has(gp, " with lines dt 2")) << gp;
   EXPECT_TRUE(has(gp, "1/6 (alike by design)")) << gp;
-  EXPECT_TRUE(has(gp, "set key outside")) << gp;
+  EXPECT_TRUE(has(gp, "set key outside right top vertical Left reverse")) << gp;
+  // Centred on the picture: centred on the plot, which the legend narrows, its second line ran
+  // past the left edge and was clipped.
+  EXPECT_FALSE(has(gp, "set title")) << gp;
+  EXPECT_TRUE(has(gp, "set label 1 \"throw.height.mean\\nscenes/fair.toml, fidelity paper, 300 tosses per point")) << gp;
+  EXPECT_TRUE(has(gp, "\" at screen 0.5, screen 0.97 center front")) << gp;
   // Die 1 (steel over aluminium) is unfair by design: no 1/6 line.
   const std::string die1 = plot_script("sweep scenes/paper/die1.toml --param floor.restitution --values 0.3,0.6 -n 200", "die1-e");
   EXPECT_FALSE(has(die1, "alike by design")) << die1;
@@ -62,15 +68,46 @@ TEST(CliPlots, ACoinsSweepNamesItsSidesAndDrawsItsQuestion) {
   const std::string gp = plot_script("sweep scenes/coins/three-sided.toml -n 100 --fidelity static", "three-sided");
   for (const char* side : {"title \"edge\"", "title \"heads\"", "title \"tails\""}) EXPECT_TRUE(has(gp, side)) << side << gp;
   EXPECT_FALSE(has(gp, "face 0")) << gp;
-  EXPECT_TRUE(has(gp, "reference 1/3") || has(gp, "reference 0.333333")) << gp;
+  EXPECT_TRUE(has(gp, "title \"reference 1/3\"")) << gp;
   EXPECT_TRUE(has(gp, "set yrange [0:")) << gp;
+}
+
+// The y range held our points but not the seed's circles: Table 8's P(6) = 0.26 at k = 19/30 (the
+// seed's peak, the point of the comparison) was drawn above the picture's top.
+TEST(CliPlots, TheSeedsValuesAreInsideTheYRange) {
+  const std::string gp = plot_script("sweep scenes/paper/sweeps/volume-ratio.toml -n 2000", "ratio");
+  const std::size_t at = gp.find("set yrange [0:");
+  ASSERT_NE(at, std::string::npos) << gp;
+  const double ymax = std::stod(gp.substr(at + 14));
+  // The largest value of a data block's columns (after x): ours (p, lo, hi per face; then the share
+  // without an answer) or the seed's (p per face).
+  const auto block_max = [&](const std::string& name, int* rows) {
+    const std::size_t from = gp.find(name + " << EOD\n");
+    EXPECT_NE(from, std::string::npos) << name;
+    const std::size_t start = from + name.size() + 8;
+    std::istringstream lines(gp.substr(start, gp.find("EOD\n", start) - start));
+    double most = 0.0, v = 0.0;
+    *rows = 0;
+    for (std::string line; std::getline(lines, line); ++*rows) {
+      std::istringstream fields(line);
+      fields >> v;  // x
+      while (fields >> v) most = std::max(most, v);
+    }
+    return most;
+  };
+  int ours_rows = 0, seed_rows = 0;
+  const double ours = block_max("$d", &ours_rows), seed = block_max("$s", &seed_rows);
+  EXPECT_EQ(seed_rows, 30) << "one seed row per point of Table 8";
+  ASSERT_GT(seed, ours) << "the seed's peak must stand above our bands for this test to see anything";
+  EXPECT_GT(ymax, seed) << gp;
 }
 
 TEST(CliPlots, TossesWithoutAnAnswerAreShown) {
   // A one-bounce cap leaves most paper tosses unresolved: the plot draws their share.
   const std::string gp = plot_script(
       "sweep scenes/fair.toml --param throw.height.mean --values 0.5,1 -n 200 --fidelity paper --set sim.max_bounces=1", "capped");
-  EXPECT_TRUE(has(gp, "unresolved + invalid (of all tosses)")) << gp;
+  EXPECT_TRUE(has(gp, "title \"unresolved + invalid\"")) << gp;
+  EXPECT_TRUE(has(gp, "unresolved + invalid: their share of all tosses")) << gp;
   // 1.5 m: no draw starts below the floor (at 0.5 m a few of 100 do, and count as invalid).
   const std::string clean = plot_script("sweep scenes/fair.toml --param throw.height.mean --values 1.5 -n 100 --fidelity static", "clean");
   EXPECT_TRUE(has(clean, "every toss settled")) << clean;
@@ -86,6 +123,26 @@ TEST(CliPlots, AFitProfileHasUnitsTheRunAndItsLegendBelow) {
   EXPECT_TRUE(has(gp, "scenes/paper/die1.toml, fidelity static")) << gp;
   EXPECT_TRUE(has(gp, "500 observed tosses")) << gp;
   EXPECT_TRUE(has(gp, "set key below")) << gp;
+  // The dashed bounds named in the legend with their unit (the picture gave no numbers for them).
+  EXPECT_TRUE(has(gp, "title \"95% interval [")) << gp;
+  EXPECT_TRUE(has(gp, "] kg/m^3 (cut 3.84)\"")) << gp;
+}
+
+// The key sat at a fixed place inside the axes, where a loaded machine's slower rows ran under it;
+// the title did not say how many tosses, which seed or how many threads.
+TEST(CliPlots, ATradeoffSaysItsRunAndKeepsItsLegendOffTheData) {
+  const std::string csv = dicesim::testing::unique_temp("tradeoff.csv");
+  const std::string gp = plot_script("bench tradeoff scenes/fair.toml -n 20 --steps 2e-3,1e-3 --csv " + csv, "tradeoff");
+  EXPECT_TRUE(has(gp, "\"scenes/fair.toml: accuracy against speed\\n20 tosses per row (the same indices in each, seed 1), 1 thread;"))
+      << gp;
+  EXPECT_TRUE(has(gp, "set key below")) << gp;
+  EXPECT_FALSE(has(gp, "set key at graph")) << gp;
+  EXPECT_FALSE(has(gp, "set title")) << "centred on the plot, the title was clipped: " << gp;
+  EXPECT_TRUE(has(gp, "tosses per second (all threads; depends on the machine and its load)")) << gp;
+  // The same program redraws the CSV without tossing.
+  const std::string again = plot_script("bench tradeoff scenes/fair.toml --from-csv " + csv, "tradeoff-again");
+  EXPECT_TRUE(has(again, "rows from " + csv)) << again;
+  EXPECT_TRUE(has(again, "set key below")) << again;
 }
 
 TEST(CliInfo, ACoinsEdgeIsACurvedSideNotAZeroNormal) {

@@ -18,6 +18,18 @@ def test_toss_takes_a_path_as_fit_does(dicesim, die1):
         dicesim.toss(42, 10)
 
 
+def test_power_takes_paths_for_both_scenes(dicesim, die1):
+    small = dict(n=2000, replicates=200, bootstrap=100, seed=3, threads=1)
+    by_path = dicesim.power(DIE1, against=Path("scenes/fair.toml"), **small)
+    by_scene = dicesim.power(die1, against=dicesim.load_scene("scenes/fair.toml"), **small)
+    assert by_path["against"] == "scenes/fair.toml"
+    for key in by_scene:
+        if key not in ("elapsed_s",):
+            assert by_path[key] == by_scene[key], key
+    with pytest.raises(TypeError, match="scene must be a dicesim.Scene or a path"):
+        dicesim.power(die1, against=6, **small)
+
+
 def test_a_count_may_be_an_integral_float(dicesim, die1):
     assert dicesim.toss(die1, 1e3).tosses == 1000
     assert dicesim.toss(die1, 2.5e2, seed=2).counts.tolist() == dicesim.toss(die1, 250, seed=2).counts.tolist()
