@@ -123,6 +123,16 @@ std::string fraction_text(double v) {
   return short_text(v);
 }
 
+// The first point's die: the outcomes' labels and names are every point's (run_sweep checks).
+DieModel first_point_model(const SweepSpec& spec, SceneDef* def = nullptr) {
+  std::vector<std::string> all = spec.overrides;
+  all.insert(all.end(), spec.points[0].overrides.begin(), spec.points[0].overrides.end());
+  SceneDef d = load_scene(spec.scene, all);
+  DieModel m = compile(d, spec.scene);
+  if (def) *def = std::move(d);
+  return m;
+}
+
 PlotLabels plot_labels(const SweepSpec& spec, const SweepArgs& a, bool file_mode) {
   PlotLabels pl;
   pl.x_label = spec.x_label;
@@ -138,10 +148,8 @@ PlotLabels plot_labels(const SweepSpec& spec, const SweepArgs& a, bool file_mode
       pl.x_label += " (" + unit + ")";
   }
   if (spec.points.empty()) return pl;
-  std::vector<std::string> all = spec.overrides;
-  all.insert(all.end(), spec.points[0].overrides.begin(), spec.points[0].overrides.end());
-  const SceneDef def = load_scene(spec.scene, all);
-  const DieModel m = compile(def, spec.scene);
+  SceneDef def;
+  const DieModel m = first_point_model(spec, &def);
   pl.names = outcome_names(m);
   if (pl.names.empty())
     for (int l : m.outcome_labels) pl.names.push_back("face " + std::to_string(l));
@@ -346,7 +354,9 @@ nlohmann::json json_report(const SweepSpec& spec, const SweepResult& res, const 
   return j;
 }
 
-std::string table_text(const SweepSpec& spec, const SweepResult& res, int threads, int workers, const Provenance& prov) {
+// names: a coin's side per outcome (P(edge), not P(0)); empty for a die (P(1)..).
+std::string table_text(const SweepSpec& spec, const SweepResult& res, int threads, int workers, const Provenance& prov,
+                       const std::vector<std::string>& names) {
   std::ostringstream out;
   out << spec.title << "  (" << spec.scene << ", fidelity " << (res.points.empty() ? "" : res.points[0].fidelity)
       << ", seed " << spec.seed << ", " << spec.tosses << " tosses per point, ";
@@ -372,8 +382,11 @@ std::string table_text(const SweepSpec& spec, const SweepResult& res, int thread
   char line[512];
   std::snprintf(line, sizeof line, "%-14s", spec.x_label.size() <= 14 ? spec.x_label.c_str() : "x");
   out << line;
-  for (const FaceEstimate& f : first) {
-    std::snprintf(line, sizeof line, "  %7s", ("P(" + std::to_string(f.label) + ")").c_str());
+  std::vector<int> widths;
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    const std::string head = "P(" + (i < names.size() ? names[i] : std::to_string(first[i].label)) + ")";
+    widths.push_back(std::max<int>(7, static_cast<int>(head.size())));
+    std::snprintf(line, sizeof line, "  %*s", widths.back(), head.c_str());
     out << line;
   }
   out << "   unresolved  invalid\n";
@@ -381,9 +394,11 @@ std::string table_text(const SweepSpec& spec, const SweepResult& res, int thread
   for (const SweepPointResult& r : res.points) {
     std::snprintf(line, sizeof line, "%-14s", r.point.label.c_str());
     out << line;
-    for (const FaceEstimate& f : face_estimates(r.counts, r.labels)) {
-      out << fmt("  %7.4f", f.p);
-      worst = std::max(worst, f.ci95.half_width());
+    const auto est = face_estimates(r.counts, r.labels);
+    for (std::size_t i = 0; i < est.size(); ++i) {
+      std::snprintf(line, sizeof line, "  %*.4f", i < widths.size() ? widths[i] : 7, est[i].p);
+      out << line;
+      worst = std::max(worst, est[i].ci95.half_width());
     }
     std::snprintf(line, sizeof line, "   %10llu  %7llu\n", static_cast<unsigned long long>(r.counts.unresolved),
                   static_cast<unsigned long long>(r.counts.invalid));
@@ -541,7 +556,10 @@ int run_sweep_cmd(SweepArgs a) {
   if (a.json)
     std::printf("%s\n", json_report(spec, res, seed_rows, a.threads, a.workers, prov).dump().c_str());
   else if (a.csv != "-")
-    std::fputs(table_text(spec, res, a.threads, a.workers, prov).c_str(), stdout);
+    std::fputs(table_text(spec, res, a.threads, a.workers, prov,
+                          spec.points.empty() ? std::vector<std::string>{} : outcome_names(first_point_model(spec)))
+                   .c_str(),
+               stdout);
   if (interrupted) {
     std::fprintf(stderr, "dicesim: interrupted after %zu of %zu points\n", res.points.size(), spec.points.size());
     return kExitInterrupted;

@@ -101,3 +101,15 @@ TEST(CliFirstHour, TradeoffStepsTakeCommasAndSayWhatIsAccepted) {
                    {"--steps", "'1e-3x' is not a step", "[1e-7, 0.01]", "commas or spaces"});
   expect_bad_input(cli("bench tradeoff scenes/fair.toml -n 20 --steps 2e-3,0.5"), {"'0.5' is not a step"});
 }
+
+// The sweep's table headed a coin's columns P(0), P(1), P(2) while its plot named the sides.
+TEST(CliFirstHour, ACoinsSweepTableNamesItsSides) {
+  const CliRun coin = cli("sweep scenes/coins/three-sided.toml -n 50 --fidelity static");
+  ASSERT_EQ(coin.code, 0) << coin.err;
+  EXPECT_NE(coin.out.find(" P(edge)  P(heads)  P(tails)   unresolved  invalid\n0.1              0.1400    0.4400"),
+            std::string::npos)
+      << coin.out;
+  EXPECT_EQ(coin.out.find("P(0)"), std::string::npos) << coin.out;
+  const CliRun die = cli("sweep scenes/fair.toml --param floor.restitution --values 0.3 -n 100 --fidelity static");
+  EXPECT_NE(die.out.find("   P(1)     P(2)     P(3)     P(4)     P(5)     P(6)   unresolved"), std::string::npos) << die.out;
+}
