@@ -138,7 +138,7 @@ int run_tradeoff(const TradeoffArgs& a) {
   (void)compile(base, a.scene.path);  // bad scenes fail before any work
   if (!a.from_csv.empty()) {  // redraw an earlier run's rows: no tossing
     if (a.plot.empty()) throw SceneError("dicesim bench tradeoff", "--from-csv", a.from_csv, "needs --plot FILE.png");
-    if (!std::ifstream(a.from_csv)) throw SceneError("dicesim bench tradeoff", "--from-csv", a.from_csv, "a readable file");
+    if (!std::ifstream(a.from_csv)) throw SceneError("dicesim bench tradeoff", "--from-csv", a.from_csv, "must be a readable file");
     plot_tradeoff_csv(a.from_csv, a.plot,
                       a.scene.path + ": accuracy against speed\nrows from " + a.from_csv +
                           "; point labels: each row's setting (a step in s; paper: its stop speed in m/s)");

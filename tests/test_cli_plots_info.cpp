@@ -143,6 +143,9 @@ TEST(CliPlots, ATradeoffSaysItsRunAndKeepsItsLegendOffTheData) {
   const std::string again = plot_script("bench tradeoff scenes/fair.toml --from-csv " + csv, "tradeoff-again");
   EXPECT_TRUE(has(again, "rows from " + csv)) << again;
   EXPECT_TRUE(has(again, "set key below")) << again;
+  dicesim::testing::expect_bad_input(cli("bench tradeoff scenes/fair.toml --from-csv /no/such.csv --plot x.png"),
+                                     {"--from-csv", "/no/such.csv", "must be a readable file"});
+  dicesim::testing::expect_bad_input(cli("bench tradeoff scenes/fair.toml --from-csv " + csv), {"--from-csv", "needs --plot"});
 }
 
 TEST(CliInfo, ACoinsEdgeIsACurvedSideNotAZeroNormal) {
