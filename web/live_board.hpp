@@ -20,7 +20,9 @@ namespace dicesim::web {
 
 class LiveBoard {
  public:
-  // key: a run key (messages/auth.hpp): only messages whose seal opens count; empty: none.
+  // key: a run key (messages/auth.hpp): only messages whose seal opens count, the others are
+  // counted as unauthenticated. Empty: unsealed messages count, sealed ones (a run with a key)
+  // are counted as sealed and not shown.
   explicit LiveBoard(const std::vector<std::uint8_t>& key = {});
 
   // One message as heard on `channel` (sealed bytes). Others' channels are ignored.
@@ -31,7 +33,8 @@ class LiveBoard {
   //  total, tosses_per_s, eta_s, finished, workers, duplicates, rejected_foreign, rejected_malformed,
   //  rejected_range, rejected_unauthenticated, released} or null, "workers": [{id, host, pid, state,
   //  error, tosses_done, tosses_per_s, age_s, health: "ok"|"late"|"silent"}],
-  //  "heard": {unauthenticated, malformed} (what this server could not open or decode)}.
+  //  "heard": {unauthenticated (seal missing or wrong), sealed (sealed, and this server has no key),
+  //  malformed} (what this server could not open or decode), "key": whether it has a key}.
   std::string json(std::uint64_t* version = nullptr) const;
   // Waits until the version differs from `seen` or `timeout` passes; returns the version.
   std::uint64_t wait(std::uint64_t seen, std::chrono::milliseconds timeout) const;
@@ -47,7 +50,7 @@ class LiveBoard {
   std::uint64_t version_ = 0;
   nlohmann::json run_;  // the latest answer (of the latest run heard)
   std::map<std::int64_t, Worker> workers_;
-  std::uint64_t unauthenticated_ = 0, malformed_ = 0;
+  std::uint64_t unauthenticated_ = 0, sealed_ = 0, malformed_ = 0;
 };
 
 }  // namespace dicesim::web

@@ -37,12 +37,22 @@
         row.querySelector('.num').innerHTML = '<span class="p" data-label="' + label + '">' + r.p[i].toFixed(5) + '</span> [' +
           r.ci_lo[i].toFixed(4) + ', ' + r.ci_hi[i].toFixed(4) + '] <span class="count">' + r.counts[i] + '</span>';
       });
-      $('health').innerHTML = [['duplicates', r.duplicates], ['released (lost batches, expired leases)', r.released],
-        ['rejected: another run', r.rejected_foreign], ['rejected: malformed', r.rejected_malformed],
-        ['rejected: index out of range', r.rejected_range], ['rejected: unauthenticated', r.rejected_unauthenticated],
-        ['heard here, unauthenticated', state.heard.unauthenticated], ['heard here, undecodable', state.heard.malformed]]
-        .map((x) => '<tr><td>' + esc(x[0]) + '</td><td>' + x[1] + '</td></tr>').join('');
     }
+    // What the aggregator rejected (with a run), and what this server heard but could not open:
+    // shown with or without a run (a run whose messages all fail the seal never shows one).
+    const h = state.heard;
+    const rows = r ? [['duplicates', r.duplicates], ['released (lost batches, expired leases)', r.released],
+      ['rejected: another run', r.rejected_foreign], ['rejected: malformed', r.rejected_malformed],
+      ['rejected: index out of range', r.rejected_range], ['rejected: unauthenticated', r.rejected_unauthenticated]] : [];
+    rows.push(['heard here, unauthenticated (seal missing or wrong)', h.unauthenticated, 'heard-unauthenticated'],
+      ['heard here, sealed (needs --key-file)', h.sealed, 'heard-sealed'], ['heard here, undecodable', h.malformed, 'heard-malformed']);
+    $('health').innerHTML = rows.map((x) => '<tr><td>' + esc(x[0]) + '</td><td' + (x[2] ? ' id="' + x[2] + '"' : '') + '>' + x[1] + '</td></tr>').join('');
+    const notes = [];
+    if (h.sealed > 0) notes.push(h.sealed + ' messages heard are sealed with a run key, and this server has none: they are not shown (start dicesim serve with --key-file FILE).');
+    if (h.unauthenticated > 0) notes.push(h.unauthenticated + ' messages heard failed the HMAC check' +
+      (state.key ? ' (sealed with another key, unsealed, or forged)' : '') + ': they are not shown.');
+    $('auth').textContent = notes.join(' ');
+    $('auth').hidden = notes.length === 0;
     $('workers').innerHTML = '<tr><th>worker</th><th>host</th><th>pid</th><th>state</th><th>tosses</th><th>tosses/s</th><th>last heard</th></tr>' +
       state.workers.map((w) => '<tr><td>' + esc(w.id.toString(16)) + '</td><td>' + esc(w.host) + '</td><td>' + w.pid + '</td><td>' + esc(w.state) +
         (w.error ? ': ' + esc(w.error) : '') + '</td><td>' + w.tosses_done + '</td><td>' + Math.round(w.tosses_per_s) +

@@ -11,6 +11,9 @@
 #   serve      `dicesim serve` during a `dicesim run` on the same bus: a second serve on the same
 #              port is exit 2; once the run ends, /state and the last server-sent event (curl of the
 #              stream) show the run's final counts and probabilities.
+#   serve_key  an authenticated run (--key-file) and three serves: with its key the page shows the
+#              run's counts; without a key (sealed) and with another key (unauthenticated) the page
+#              shows no run, counts the messages in its health table and says why.
 # Screenshots are kept in $DICESIM_BROWSER_SHOTS when that is set (to look at them).
 set -euo pipefail
 
@@ -59,8 +62,79 @@ PY
   exit 0
 }
 
+# A serve on `port` with `args`, waited for (its /state answers).
+start_serve() {
+  local port=$1; shift
+  "$bin" serve --port "$port" "$@" > "$work/serve-$port.out" 2> "$work/serve-$port.err" & pids+=($!)
+  for _ in $(seq 100); do curl -sf "http://127.0.0.1:$port/state" > /dev/null && break; sleep 0.1; done
+  curl -sf "http://127.0.0.1:$port/state" > /dev/null || { cat "$work/serve-$port.err" >&2; fail "serve on $port did not start"; }
+}
+
+# The live page at `url` as Chromium shows it after BROWSE_S (3) seconds of real time: its DOM
+# ($work/WHAT-dom.out), a screenshot ($work/WHAT.png); no console error or uncaught exception.
+# (The page keeps its event stream open, so --virtual-time-budget would never end and --dump-dom
+# alone does not wait: cdp_page.py drives Chromium over the DevTools protocol instead.)
+browse_live() {
+  local what=$1 url=$2
+  timeout 120 /usr/bin/python3 tests/integration/cdp_page.py "$url" "${BROWSE_S:-3}" "$work/$what-dom.out" "$work/$what.png" \
+    "$work/$what-errors.txt" || fail "chromium ($what) failed"
+  if [ -n "${DICESIM_BROWSER_SHOTS:-}" ]; then mkdir -p "$DICESIM_BROWSER_SHOTS"; cp "$work/$what.png" "$DICESIM_BROWSER_SHOTS/$what.png"; fi
+  [ ! -s "$work/$what-errors.txt" ] || { cat "$work/$what-errors.txt" >&2; fail "the page ($what) logged an error"; }
+}
+
+# An authenticated run (--key-file) followed by three serves: with the run's key it shows the run's
+# counts; without a key, and with another key, it shows no run but counts what it heard (sealed,
+# and unauthenticated) in the page's health table, with a note saying why nothing is shown.
+serve_key_scenario() {
+  local key=$work/run.key other=$work/other.key
+  (umask 077; od -An -tx1 -N32 /dev/urandom | tr -d ' \n' > "$key"; od -An -tx1 -N32 /dev/urandom | tr -d ' \n' > "$other")
+  start_serve 18041 --key-file "$key"
+  start_serve 18042
+  start_serve 18043 --key-file "$other"
+  "$bin" run scenes/paper/die1.toml --workers 2 --tosses 100000 --seed 12 --json --key-file "$key" --lcm "$LCM_DEFAULT_URL" \
+    > "$work/run.json" 2> "$work/run.err" || { tail "$work/run.err" >&2; fail "run exited $?"; }
+  sleep 1.5  # the final answer reaches the serves
+  for port in 18041 18042 18043; do
+    browse_live "serve-$port" "http://127.0.0.1:$port/"
+    curl -sf "http://127.0.0.1:$port/state" > "$work/state-$port.json"
+  done
+  /usr/bin/python3 - "$work" <<'PY' || fail "the serves do not show what their key opens"
+import json, re, sys
+work = sys.argv[1]
+run = json.load(open(f"{work}/run.json"))
+counts = {str(f["face"]): f["count"] for f in run["faces"]}
+def page(port):
+    dom = open(f"{work}/serve-{port}-dom.out").read()
+    cell = lambda i: int(re.search(f'id="{i}">([0-9]+)<', dom).group(1))
+    shown = dict(re.findall(r'<span class="p" data-label="([0-9]+)">[^<]*</span>[^<]*<span class="count">([0-9]+)</span>', dom))
+    auth = re.search(r'<p id="auth"( hidden="")?>([^<]*)</p>', dom)
+    return json.load(open(f"{work}/state-{port}.json")), {k: int(v) for k, v in shown.items()}, cell, auth
+state, shown, cell, auth = page(18041)  # the run's key
+assert state["run"] and state["run"]["finished"], "the keyed serve shows no finished run"
+assert dict(zip(map(str, state["run"]["labels"]), state["run"]["counts"])) == counts, (state["run"]["counts"], counts)
+assert shown == counts, f"the keyed page shows {shown}, the run counted {counts}"
+assert state["heard"]["unauthenticated"] == 0 and state["heard"]["sealed"] == 0, state["heard"]
+assert cell("heard-unauthenticated") == 0 and auth.group(1), "the keyed page reports unauthenticated messages"
+state, shown, cell, auth = page(18042)  # no key
+assert state["run"] is None and not shown, "a serve without the key shows the sealed run"
+sealed = cell("heard-sealed")
+assert state["heard"]["sealed"] > 0 and sealed > 0, "a serve without the key counts no sealed messages"
+assert not auth.group(1) and "--key-file" in auth.group(2), f"no note on the page without the key: {auth.group(0)}"
+state, shown, cell, auth = page(18043)  # another key
+assert state["run"] is None and not shown, "a serve with another key shows the run"
+unauthenticated = cell("heard-unauthenticated")
+assert state["heard"]["unauthenticated"] > 0 and unauthenticated > 0, "a serve with another key counts nothing unauthenticated"
+assert not auth.group(1) and "HMAC" in auth.group(2), f"no note on the page with another key: {auth.group(0)}"
+print(f"keyed serve: counts {counts} on the page; on the pages without a key: {sealed} sealed, with another key:",
+      f"{unauthenticated} unauthenticated")
+PY
+  echo "PASS [$scenario]"
+  exit 0
+}
+
 case "$scenario" in
   serve) serve_scenario ;;
+  serve_key) serve_key_scenario ;;
   show_die) scene=scenes/dice/loaded-d20.toml; args=(); hash="" ;;
   show_toss) scene=scenes/dice/d20.toml; args=(--fidelity impulse --toss 7); hash="#t=end" ;;
   *) fail "unknown scenario" ;;
