@@ -206,13 +206,19 @@ w, h = img.size
 view = img.crop((0, 0, int(w * 0.55), h))  # the 3-D view is the left 60 % of the page
 px = list(view.getdata())
 bg = (0xf4, 0xf4, 0xf1)
-off = sum(1 for p in px if sum(abs(a - b) for a, b in zip(p, bg)) > 30)
+# A canvas never drawn is blank (black in Chromium's screenshot, 100 % "off the background" and
+# "dark"): the renderer's clear to the scene's background must cover much of the view, and the die
+# on it must be shaded (many colours), with some dark label pixels but not a dark view.
+on_bg = sum(1 for p in px if sum(abs(a - b) for a, b in zip(p, bg)) <= 30)
+off = len(px) - on_bg
+colours = len({p for p in px if sum(abs(a - b) for a, b in zip(p, bg)) > 30})
 dark = sum(1 for p in px if max(p) < 80)  # label digits
 gold = sum(1 for p in px if p[0] > 200 and p[1] > 190 and p[2] < 150 and p[0] - p[2] > 90)  # the face read (yellow)
 orange = sum(1 for p in px if p[0] > 170 and 90 < p[1] < 190 and p[2] < 140 and p[0] - p[1] > 50)  # a steel region
 n = len(px)
-print(f"{w}x{h}: {off / n:.1%} of the view off the background, {dark} dark, {gold} gold, {orange} orange pixels")
-ok = off > 0.02 * n and dark > 50
+print(f"{w}x{h}: {on_bg / n:.1%} of the view the scene's background, {off / n:.1%} off it in {colours} colours,",
+      f"{dark} dark, {gold} gold, {orange} orange pixels")
+ok = on_bg > 0.2 * n and off > 0.02 * n and colours > 50 and 50 < dark < 0.1 * n
 if sys.argv[2] == "show_toss":
     ok = ok and gold > 100
 else:
