@@ -14,6 +14,9 @@
 #   serve_key  an authenticated run (--key-file) and three serves: with its key the page shows the
 #              run's counts; without a key (sealed) and with another key (unauthenticated) the page
 #              shows no run, counts the messages in its health table and says why.
+#   serve_trace `serve --trace-every 1000` during a d20 `impulse` run: the page animates the run's
+#              latest 1000th toss in show's viewer: the same data as `show --toss I` (the page's
+#              JSON equal), its index and outcome in the page text, its clock running, the view drawn.
 # Screenshots are kept in $DICESIM_BROWSER_SHOTS when that is set (to look at them).
 set -euo pipefail
 
@@ -132,9 +135,72 @@ PY
   exit 0
 }
 
+# serve --trace-every during a d20 `impulse` run: the page animates, in show's viewer, the run's
+# latest K-th toss, made by serve itself; it is the toss `show --toss I` makes (the same page
+# data), its index and outcome are in the page text, its clock runs, and the view is drawn.
+serve_trace_scenario() {
+  local port=18045 every=1000 tosses=20000 seed=13 scene=scenes/dice/d20.toml
+  start_serve $port --trace-every $every
+  "$bin" run $scene --fidelity impulse --workers 2 --tosses $tosses --seed $seed --json --lcm "$LCM_DEFAULT_URL" \
+    > "$work/run.json" 2> "$work/run.err" || { tail "$work/run.err" >&2; fail "run exited $?"; }
+  sleep 1.5  # the final answer reaches serve
+  curl -sf "http://127.0.0.1:$port/state" > "$work/state.json"
+  local index=$((every * ((tosses - 1) / every)))
+  local run
+  run=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["trace"]["run"])' "$work/state.json")
+  curl -sf "http://127.0.0.1:$port/trace?run=$run&index=$index" > "$work/trace.html" || fail "GET /trace of toss $index failed"
+  code=$(curl -s -o "$work/unknown.html" -w '%{http_code}' "http://127.0.0.1:$port/trace?run=1&index=0")
+  [ "$code" = 404 ] && grep -q 'id="trace-error"' "$work/unknown.html" || fail "an unknown run's trace is $code, not 404 with a reason"
+  "$bin" show $scene --fidelity impulse --seed $seed --tosses $tosses --toss $index -o "$work/show.html" 2> "$work/show.err" ||
+    { cat "$work/show.err" >&2; fail "show exited $?"; }
+  BROWSE_S=${BROWSE_S:-8} browse_live serve-trace "http://127.0.0.1:$port/"
+  /usr/bin/python3 - "$work" "$index" "$every" <<'PY' || fail "the served page does not animate show's toss $index"
+import json, re, sys
+from PIL import Image
+work, index, every = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+data = lambda path: json.loads(re.search(r'<script id="dicesim-data" type="application/json">(.*?)</script>',
+                                         open(path).read(), re.S).group(1).replace("<\\/", "</"))
+state = json.load(open(f"{work}/state.json"))
+assert state["run"]["finished"], "the run is not finished"
+tr = state["trace"]
+assert tr["every"] == every and tr["index"] == index and tr["run_start"], tr
+served, shown = data(f"{work}/trace.html"), data(f"{work}/show.html")
+assert served["toss"] == shown["toss"], "serve's toss is not show --toss's"
+assert served["die"] == shown["die"] and served["info"] == shown["info"], "serve's die is not show's"
+toss = shown["toss"]
+dom = open(f"{work}/serve-trace-dom.out").read()
+cell = lambda i: re.search(f'id="{i}">([^<]*)<', dom)
+assert cell("trace-index") and int(cell("trace-index").group(1)) == index, f"the page shows toss {cell('trace-index')}, not {index}"
+assert cell("trace-outcome").group(1) == toss["outcome"], (cell("trace-outcome").group(1), toss["outcome"])
+clock = re.search(r"t = ([0-9.]+) s", cell("trace-clock").group(1))
+assert clock and float(clock.group(1)) > 0, f"the toss is not playing: clock {cell('trace-clock').group(1)!r}"
+# The view: the 3-D floor and die (warm greys: r - b >= 12) cover a share of the page; the serve
+# page's own colours are neutral or blue, and a blank canvas shows the scene's neutral background.
+img = Image.open(f"{work}/serve-trace.png").convert("RGB")
+px = list(img.getdata())
+is_warm = lambda p: p[0] > 150 and p[0] - p[2] >= 12 and p[0] - p[1] <= 20
+warm = sum(1 for p in px if is_warm(p))
+# The die in it: its label digits are dark pixels inside the view (the box of the warm pixels,
+# 1st to 99th percentile: a few antialiased text pixels elsewhere are warm too).
+w = img.size[0]
+xs = sorted(i % w for i, p in enumerate(px) if is_warm(p)) or [0]
+ys = sorted(i // w for i, p in enumerate(px) if is_warm(p)) or [0]
+q = lambda v, f: v[int(f * (len(v) - 1))]
+view = img.crop((q(xs, 0.01), q(ys, 0.01), q(xs, 0.99) + 1, q(ys, 0.99) + 1))
+dark = sum(1 for p in view.getdata() if max(p) < 80)
+print(f"serve --trace-every {every}: toss {index} outcome {toss['outcome']} ({toss['bounces']} impacts), clock {clock.group(1)} s; {warm / len(px):.1%} of the page is the 3-D view's, "
+      f"{dark} dark pixels in it")
+assert warm > 0.03 * len(px), "the sampled toss is not drawn"
+assert dark > 50, "the die is not in the view"
+PY
+  echo "PASS [$scenario]"
+  exit 0
+}
+
 case "$scenario" in
   serve) serve_scenario ;;
   serve_key) serve_key_scenario ;;
+  serve_trace) serve_trace_scenario ;;
   show_die) scene=scenes/dice/loaded-d20.toml; args=(); hash="" ;;
   show_toss) scene=scenes/dice/d20.toml; args=(--fidelity impulse --toss 7); hash="#t=end" ;;
   *) fail "unknown scenario" ;;
