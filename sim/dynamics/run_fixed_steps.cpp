@@ -30,6 +30,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
   const auto finish = [&](StepperExit exit) {
     out.exit = exit;
     st.finish_phase(s);  // adaptive: the half kick still owed (a lift-off's flight starts from the true velocity)
+    if (stats && stats->observer) stats->observer->on_step(t, s);
     impacts = st.impacts;
     if (stats) {
       stats->corrections.add(st.corrections);
@@ -87,6 +88,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
         ke = kinetic_energy(m, s);
         k += coasted;
         steps += static_cast<std::uint64_t>(coasted);
+        if (stats && stats->observer) stats->observer->on_step(t, s);
         if (!(k < max_steps && t < m.max_time)) break;
       }
     }
@@ -94,6 +96,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
     ke = st.end_ke();
     ++steps;
     t += st.last_dt();
+    if (stats && stats->observer) stats->observer->on_step(t, s);
     if (st.impacts >= m.max_bounces) break;
     if (n == 0) {
       if (!allow_liftoff) continue;

@@ -168,6 +168,8 @@ served, shown = data(f"{work}/trace.html"), data(f"{work}/show.html")
 assert served["toss"] == shown["toss"], "serve's toss is not show --toss's"
 assert served["die"] == shown["die"] and served["info"] == shown["info"], "serve's die is not show's"
 toss = shown["toss"]
+assert toss["interpolated"] == [], f"stretches interpolated: {toss['interpolated']}"
+assert toss["steps_recorded"] > 0, "no sustained contact recorded: pick a toss that has some"
 dom = open(f"{work}/serve-trace-dom.out").read()
 cell = lambda i: re.search(f'id="{i}">([^<]*)<', dom)
 assert cell("trace-index") and int(cell("trace-index").group(1)) == index, f"the page shows toss {cell('trace-index')}, not {index}"
@@ -188,7 +190,8 @@ ys = sorted(i // w for i, p in enumerate(px) if is_warm(p)) or [0]
 q = lambda v, f: v[int(f * (len(v) - 1))]
 view = img.crop((q(xs, 0.01), q(ys, 0.01), q(xs, 0.99) + 1, q(ys, 0.99) + 1))
 dark = sum(1 for p in view.getdata() if max(p) < 80)
-print(f"serve --trace-every {every}: toss {index} outcome {toss['outcome']} ({toss['bounces']} impacts), clock {clock.group(1)} s; {warm / len(px):.1%} of the page is the 3-D view's, "
+print(f"serve --trace-every {every}: toss {index} outcome {toss['outcome']} ({toss['bounces']} impacts, "
+      f"{toss['steps_recorded']} sustained-contact states recorded), clock {clock.group(1)} s; {warm / len(px):.1%} of the page is the 3-D view's, "
       f"{dark} dark pixels in it")
 assert warm > 0.03 * len(px), "the sampled toss is not drawn"
 assert dark > 50, "the die is not in the view"
