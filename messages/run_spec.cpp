@@ -219,6 +219,13 @@ DieModel compile_spec(const RunSpec& spec) {
                  spec.origin);
 }
 
+void with_spec_files(const RunSpec& spec, const std::function<void(const std::string&, const std::vector<std::string>&)>& f) {
+  in_spec_dir(spec, [&](const std::string& path, const std::vector<std::string>& o) {
+    f(path, o);
+    return 0;
+  });
+}
+
 std::string spec_scene_sha256(const RunSpec& spec) {
   return in_spec_dir(spec, [](const std::string& path, const std::vector<std::string>& o) { return scene_sha256(path, o); });
 }

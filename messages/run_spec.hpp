@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,11 @@ std::uint64_t model_fingerprint(const DieModel& m);
 // Writes the files into a private temporary directory, loads and compiles them exactly as
 // `dicesim toss` would load the original, and removes the directory. Throws SceneError.
 DieModel compile_spec(const RunSpec& spec);
+
+// What compile_spec does for callers that need more than the model (`dicesim serve`'s pages: the
+// scene's definition too): writes the files into a private temporary directory, calls f(the main
+// scene's path there, the overrides to apply) and removes the directory. Throws SceneError.
+void with_spec_files(const RunSpec& spec, const std::function<void(const std::string&, const std::vector<std::string>&)>& f);
 
 // The description of a run of `scene_path` with `overrides` (any fidelity choice among them),
 // whose compiled model is `model`. Checks that the description rebuilds into exactly that model,

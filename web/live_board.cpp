@@ -7,17 +7,33 @@
 
 namespace dicesim::web {
 
-LiveBoard::LiveBoard(const std::vector<std::uint8_t>& key) : sealer_(key) {}
+LiveBoard::LiveBoard(const std::vector<std::uint8_t>& key, std::uint64_t trace_every) : sealer_(key), trace_every_(trace_every) {}
 
 void LiveBoard::handle(const std::string& channel, const void* data, std::size_t len) {
   const bool answer = channel == wire::kProbabilities, status = channel == wire::kWorkerStatus;
-  if (!answer && !status) return;
+  const bool start = trace_every_ > 0 && channel == wire::kRunStart;
+  if (!answer && !status && !start) return;
   std::lock_guard lock(mu_);
   const auto n = sealer_.open(channel, data, len);
-  if (!n) {
-    ++unauthenticated_;
+  // Without a key a sealed message would open whole: it is counted, not shown (this server cannot
+  // tell a genuine run from a forgery without the key).
+  const bool sealed_unread = !sealer_.enabled() && wire::looks_sealed(data, len);
+  if (!n || sealed_unread) {
+    ++(sealed_unread ? sealed_ : unauthenticated_);
     ++version_;
     changed_.notify_all();
+    return;
+  }
+  if (start) {
+    // Repeated every second: kept (and the page told) only when it describes another run.
+    const auto m = wire::decode<dicesim_lcm::run_start>(data, *n);
+    if (!m) {
+      ++malformed_;
+    } else if (!spec_ || spec_->run_id != m->run_id) {
+      spec_ = wire::from_message(*m);
+      ++version_;
+      changed_.notify_all();
+    }
     return;
   }
   if (answer) {
@@ -28,13 +44,16 @@ void LiveBoard::handle(const std::string& channel, const void* data, std::size_t
       // A run that has finished stays on the page until another run's answer arrives.
       const double rate = m->tosses_per_s;
       const double left = static_cast<double>(m->total - m->done);
-      run_ = {{"run_id", m->run_id}, {"labels", m->labels}, {"counts", m->counts}, {"p", m->p}, {"ci_lo", m->ci_lo},
+      run_ = {{"run_id", m->run_id}, {"run_id_text", std::to_string(m->run_id)}, {"labels", m->labels}, {"counts", m->counts}, {"p", m->p}, {"ci_lo", m->ci_lo},
               {"ci_hi", m->ci_hi}, {"settled", m->settled}, {"unresolved", m->unresolved}, {"invalid", m->invalid},
               {"done", m->done}, {"total", m->total}, {"tosses_per_s", rate},
               {"eta_s", m->finished || rate <= 0.0 ? 0.0 : left / rate}, {"finished", m->finished != 0},
               {"workers", m->workers}, {"duplicates", m->duplicates}, {"rejected_foreign", m->rejected_foreign},
               {"rejected_malformed", m->rejected_malformed}, {"rejected_range", m->rejected_range},
               {"rejected_unauthenticated", m->rejected_unauthenticated}, {"released", m->released}};
+      run_id_ = m->run_id;
+      provenance_ = nlohmann::json::parse(m->provenance, nullptr, /*allow_exceptions=*/false);
+      if (provenance_.is_discarded()) provenance_ = nullptr;
     }
   } else {
     const auto m = wire::decode<dicesim_lcm::worker_status>(data, *n);
@@ -65,11 +84,30 @@ std::string LiveBoard::json(std::uint64_t* version) const {
     w.push_back(std::move(j));
   }
   if (version) *version = version_;
-  return nlohmann::json{{"version", version_},
+  nlohmann::json trace;
+  if (trace_every_ > 0 && !run_.is_null()) {
+    const auto done = run_["done"].get<std::int64_t>();
+    trace = {{"every", trace_every_}, {"run", std::to_string(run_id_)},
+             {"index", done > 0 ? nlohmann::json(trace_every_ * ((static_cast<std::uint64_t>(done) - 1) / trace_every_)) : nlohmann::json()},
+             {"run_start", spec_ && spec_->run_id == run_id_}};
+  }
+  return nlohmann::json{{"trace", trace},{"version", version_},
                         {"run", run_.is_null() ? nlohmann::json() : run_},
                         {"workers", w},
-                        {"heard", {{"unauthenticated", unauthenticated_}, {"malformed", malformed_}}}}
+                        {"heard", {{"unauthenticated", unauthenticated_}, {"sealed", sealed_}, {"malformed", malformed_}}},
+                        {"key", sealer_.enabled()}}
       .dump();
+}
+
+std::optional<wire::RunSpec> LiveBoard::run_spec(std::int64_t run_id) const {
+  std::lock_guard lock(mu_);
+  if (spec_ && spec_->run_id == run_id) return spec_;
+  return std::nullopt;
+}
+
+nlohmann::json LiveBoard::provenance(std::int64_t run_id) const {
+  std::lock_guard lock(mu_);
+  return run_id == run_id_ ? provenance_ : nlohmann::json();
 }
 
 std::uint64_t LiveBoard::wait(std::uint64_t seen, std::chrono::milliseconds timeout) const {

@@ -3,8 +3,11 @@
 
 #include <atomic>
 #include <chrono>
+#include <deque>
+#include <mutex>
 #include <thread>
 
+#include <algorithm>
 #include <arpa/inet.h>
 #include <httplib.h>
 #include <netinet/in.h>
@@ -20,6 +23,10 @@ struct PageServer::Impl {
   httplib::Server http;
   int port = 0;
   std::atomic<bool> stopping{false};
+  std::mutex trace_mu;
+  TracePages trace_pages;
+  // The last pages made: every browser on the page asks for the same few tosses.
+  std::deque<std::pair<std::pair<std::int64_t, std::uint64_t>, TracePage>> trace_cache;
 };
 
 PageServer::PageServer(const LiveBoard& board) : impl_(std::make_unique<Impl>()) {
@@ -37,6 +44,34 @@ PageServer::PageServer(const LiveBoard& board) : impl_(std::make_unique<Impl>())
   s->http.Get("/state", [s](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
     res.set_content(s->board->json(), "application/json");
+  });
+  s->http.Get("/trace", [s](const httplib::Request& req, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-store");
+    std::int64_t run = 0;
+    std::uint64_t index = 0;
+    try {
+      run = std::stoll(req.get_param_value("run"));
+      index = std::stoull(req.get_param_value("index"));
+    } catch (const std::exception&) {
+      res.status = 400;
+      res.set_content("trace?run=RUN_ID&index=I", "text/plain");
+      return;
+    }
+    std::lock_guard lock(s->trace_mu);
+    if (!s->trace_pages) {
+      res.status = 404;
+      res.set_content("no sampled tosses: dicesim serve was started without --trace-every", "text/plain");
+      return;
+    }
+    const std::pair<std::int64_t, std::uint64_t> key{run, index};
+    auto hit = std::find_if(s->trace_cache.begin(), s->trace_cache.end(), [&](const auto& e) { return e.first == key; });
+    if (hit == s->trace_cache.end()) {
+      s->trace_cache.emplace_back(key, s->trace_pages(run, index));
+      if (s->trace_cache.size() > 4) s->trace_cache.pop_front();
+      hit = std::prev(s->trace_cache.end());
+    }
+    res.status = hit->second.status;
+    res.set_content(hit->second.html, "text/html; charset=utf-8");
   });
   s->http.Get("/events", [s](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
@@ -107,6 +142,12 @@ bool PageServer::bind(const std::string& addr, int port) {
 }
 
 int PageServer::port() const { return impl_->port; }
+
+void PageServer::set_trace_pages(TracePages pages) {
+  std::lock_guard lock(impl_->trace_mu);
+  impl_->trace_pages = std::move(pages);
+  impl_->trace_cache.clear();
+}
 
 void PageServer::run() { impl_->http.listen_after_bind(); }
 

@@ -195,8 +195,10 @@
   const orbit = { theta: -Math.PI / 3, phi: 1.05, dist: 5 * R };
   const home = Object.assign({}, orbit);
   const target = new THREE.Vector3();
-  function placeCamera() {
-    if (toss) target.lerp(body.position, 0.15);
+  // The view follows the die with a lag of ~0.1 s of real time, however few frames a second the
+  // browser draws (a per-frame step left the die out of view in a slow, software-drawn browser).
+  function placeCamera(dt) {
+    if (toss) target.lerp(body.position, 1 - Math.exp(-dt / 0.1));
     const s = Math.sin(orbit.phi);
     camera.position.set(target.x + orbit.dist * s * Math.cos(orbit.theta), target.y + orbit.dist * s * Math.sin(orbit.theta),
       target.z + orbit.dist * Math.cos(orbit.phi));
@@ -280,13 +282,15 @@
   } else {
     show(0);
   }
+  let camMs = null;
   function frame(ms) {
     if (playing && lastMs !== null) {
       show(t + (ms - lastMs) / 1000 * parseFloat($('speed').value));
       if (t >= tEnd) { playing = false; $('play').textContent = 'Replay'; }
     }
     lastMs = ms;
-    placeCamera();
+    placeCamera(camMs === null ? 1 : Math.min(1, (ms - camMs) / 1000));
+    camMs = ms;
     renderer.render(scene, camera);
     requestAnimationFrame(frame);
   }

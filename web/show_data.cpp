@@ -3,10 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "sim/body/outcome.hpp"
+#include "sim/dynamics/contact_stepper.hpp"
 #include "sim/dynamics/flight.hpp"
 #include "sim/dynamics/friction_impact.hpp"
 #include "sim/models/initial_state.hpp"
@@ -181,13 +183,59 @@ json die_json(const DieModel& m, const SceneDef& def) {
   return d;
 }
 
+namespace {
+
+// A state the toss went through: the release, an impact's before and after, a fixed step's end.
+struct Known {
+  double t;
+  RigidState s;
+  bool step = false;  // recorded by the stepper (sustained contact, `stepped`'s whole toss)
+};
+
+// The stepper's states as the toss takes them, kept at most one per frame_dt of toss time (the last
+// one before each frame_dt has passed since the one kept before it: no gap between kept states is
+// longer than frame_dt or one step) and every phase's last (a lift-off's flight starts from it).
+// A phase's last state is the one on_step is given twice, at the same time.
+class StepRecorder final : public StepObserver {
+ public:
+  explicit StepRecorder(double frame_dt) : dt_(frame_dt) {}
+  void on_step(double t, const RigidState& s) override {
+    if (pending_ && t == pending_->t) {  // the phase's end
+      keep({t, s, true});
+      pending_.reset();
+      return;
+    }
+    if (pending_ && t - last_ > dt_) keep(*pending_);
+    pending_ = Known{t, s, true};
+  }
+  std::vector<Known> take() {
+    if (pending_) keep(*pending_);
+    pending_.reset();
+    return std::move(kept_);
+  }
+
+ private:
+  void keep(const Known& k) {
+    kept_.push_back(k);
+    last_ = k.t;
+  }
+  double dt_;
+  double last_ = -1.0;
+  std::optional<Known> pending_;
+  std::vector<Known> kept_;
+};
+
+}  // namespace
+
 json toss_json(const DieModel& m, std::uint64_t seed, std::uint64_t index, double frame_dt) {
   std::vector<BounceRecord> impacts;
   RigidState final_state;
   const bool have_final = m.fidelity == Fidelity::Impulse || m.fidelity == Fidelity::Stepped;
+  StepRecorder recorder(frame_dt);
   TossProbe probe;
   probe.trace = &impacts;
   probe.final_state = &final_state;
+  probe.steps_observer = &recorder;
   const TossResult r = toss(m, seed, index, &probe);
   const InitialState init = draw_initial_state(m.throw_, seed, index, m.fidelity != Fidelity::Static);
   const RigidState s0 = to_body_state(m, init);
@@ -203,34 +251,46 @@ json toss_json(const DieModel& m, std::uint64_t seed, std::uint64_t index, doubl
   t["t_end"] = r7(r.t_end);
   t["bounces"] = r.bounces;
 
-  // The states the toss recorded, in time order: the release, each impact's before and after, the
-  // end. From each, flight is exact until the next contact; where the next recorded state is not
-  // where that flight lands, the die was in sustained contact (fixed steps, not recorded): those
-  // stretches are interpolated from the flight's touchdown to the next recorded state and listed
-  // in "interpolated".
-  struct Known {
-    double t;
-    RigidState s;
-  };
+  // The states the toss went through, in time order: the release, each impact's before and after,
+  // the fixed steps' (sustained contact; `stepped`'s whole toss) as StepRecorder keeps them, the
+  // end. Between steps the page interpolates (they are at most frame_dt or one step apart); from
+  // any other state, and from a phase's last step, flight is exact until the next contact and
+  // sampled every frame_dt. A stretch where that flight does not land on the next state recorded
+  // (none is expected now that steps are recorded) is listed in "interpolated".
   std::vector<Known> known{{0.0, s0}};
   for (const BounceRecord& b : impacts) {
     known.push_back({b.t, b.before});
     known.push_back({b.t, b.after});
   }
+  for (Known& k : recorder.take()) known.push_back(std::move(k));
+  // Impacts before steps at equal times (a phase entered right after an impact); a step at the
+  // time of the state before it (a phase that took no step) adds nothing.
+  std::stable_sort(known.begin(), known.end(), [](const Known& a, const Known& b) { return a.t < b.t; });
+  std::vector<Known> merged;
+  for (Known& k : known)
+    if (!(k.step && !merged.empty() && k.t == merged.back().t)) merged.push_back(std::move(k));
+  known = std::move(merged);
   if (have_final && r.t_end > known.back().t) known.push_back({r.t_end, final_state});
   const bool moves = r.status != TossStatus::Invalid && m.fidelity != Fidelity::Static;
 
   json frames = json::array();
   json interpolated = json::array();
+  std::size_t steps_kept = 0;
   for (std::size_t i = 0; i < known.size(); ++i) {
     const Known& k = known[i];
     frames.push_back(frame(k.t, k.s));
+    steps_kept += k.step ? 1 : 0;
     const bool last = i + 1 == known.size();
     const double gap = (last ? r.t_end : known[i + 1].t) - k.t;
     if (!moves || !(gap > 0.0)) continue;
-    const Flight fl(m, k.s);
     double flight_end = gap;
-    if (!last && m.fidelity != Fidelity::Paper) {
+    if (!last && known[i + 1].step) {
+      // Within the stepper's phase: the next step is the motion. Only a `stepped` coast (its
+      // closed-form steps high above the floor) leaves a gap: free flight, drawn as exact flight.
+      if (m.fidelity != Fidelity::Stepped || !k.step || gap <= 2.0 * std::max(frame_dt, m.step)) continue;
+    }
+    const Flight fl(m, k.s);
+    if (!last && !known[i + 1].step && m.fidelity != Fidelity::Paper) {
       const RigidState landed = fl.state(gap);
       if ((landed.position - known[i + 1].s.position).norm() > 1e-6 * m.bounding_radius) {
         const ContactSearch c = fl.next_contact(gap);
@@ -244,6 +304,7 @@ json toss_json(const DieModel& m, std::uint64_t seed, std::uint64_t index, doubl
   }
   t["frames"] = frames;
   t["interpolated"] = interpolated;
+  t["steps_recorded"] = steps_kept;
 
   json imp = json::array();
   for (const BounceRecord& b : impacts) {

@@ -21,11 +21,16 @@ nlohmann::json die_json(const DieModel& m, const SceneDef& def);
 // Toss `index` of a run with `seed`: the very toss `dicesim toss`/`toss_one` makes.
 // {"seed", "index", "fidelity", "status", "face", "face_index", "outcome", "t_end", "bounces",
 //  "frames": [[t, px, py, pz, qx, qy, qz, qw]...] (body -> world), "impacts": [{"t", "kind"
-//  (corner, edge, face, rim), "corners", "impulse", "energy_before", "energy_after"}]}.
+//  (corner, edge, face, rim), "corners", "impulse", "energy_before", "energy_after"}],
+//  "steps_recorded", "interpolated": [[t0, t1]...]}.
 // Between impacts flight is exact and torque-free, so poses there are sampled from it every
 // `frame_dt` seconds. Sustained contact (`impulse`'s fixed steps between impacts, `stepped`'s
-// whole toss) records no states: those stretches are interpolated between the last flight's
-// touchdown and the next recorded state, and listed in "interpolated": [[t0, t1]...].
+// whole toss) is recorded from the stepper (TossProbe::steps_observer): its states as simulated,
+// at most one per `frame_dt` of toss time plus each phase's last (the cap: the frames number about
+// t_end / frame_dt, whatever the step), "steps_recorded" of them. `stepped`'s coasts (closed-form
+// steps high above the floor) are drawn as the exact flight they are. A stretch that could only
+// be interpolated (a flight that does not land on the next recorded state: none is expected) is
+// listed in "interpolated".
 nlohmann::json toss_json(const DieModel& m, std::uint64_t seed, std::uint64_t index, double frame_dt = 1e-3);
 
 }  // namespace dicesim::web

@@ -399,7 +399,19 @@ struct StepperOutcome {
 };
 
 // Stepper statistics handed back to the toss.
+// Watches the sustained phase without changing it (`dicesim show`'s trace of a toss): called with
+// the time and the state after every accepted step (a coast counts as one), and once more at the
+// phase's end with the state it hands back (the same time as its last step).
+class StepObserver {
+ public:
+  virtual void on_step(double t, const RigidState& s) = 0;
+
+ protected:
+  ~StepObserver() = default;
+};
+
 struct StepperStats {
+  StepObserver* observer = nullptr;  // optional; not a statistic (read, never accumulated)
   Corrections corrections;
   std::uint64_t sweeps = 0;
   std::uint64_t steps = 0;

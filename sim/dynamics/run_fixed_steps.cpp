@@ -29,6 +29,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
   std::uint64_t steps = 0;
   const auto finish = [&](StepperExit exit) {
     out.exit = exit;
+    if (stats && stats->observer) stats->observer->on_step(t, s);
     impacts = st.impacts;
     if (stats) {
       stats->corrections.add(st.corrections);
@@ -86,6 +87,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
         ke = kinetic_energy(m, s);
         k += coasted;
         steps += static_cast<std::uint64_t>(coasted);
+        if (stats && stats->observer) stats->observer->on_step(t, s);
         if (!(k < max_steps && t < m.max_time)) break;
       }
     }
@@ -93,6 +95,7 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
     ke = st.end_ke();
     ++steps;
     t += st.last_dt();
+    if (stats && stats->observer) stats->observer->on_step(t, s);
     if (st.impacts >= m.max_bounces) break;
     if (n == 0) {
       if (!allow_liftoff) continue;

@@ -32,6 +32,7 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
   bool sustained = false;
   bool after_impact = false;  // the state is right after an impact (sustained contact is possible)
   StepperStats stats;
+  if (probe) stats.observer = probe->steps_observer;
   const auto finish = [&](TossStatus status) {
     if (probe && probe->final_state) *probe->final_state = s;
     r.status = status;

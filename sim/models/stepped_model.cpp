@@ -10,6 +10,7 @@ TossResult run_stepped(const DieModel& m, RigidState s, double tiebreak, TossPro
   double t = 0.0;
   int impacts = 0;
   StepperStats stats;
+  if (probe) stats.observer = probe->steps_observer;
   PhaseTimer timer(probe, Phase::Steps);
   const StepperOutcome o = run_fixed_steps(m, s, t, impacts, m.step, tiebreak, /*allow_liftoff=*/false,
                                            ImpactThreshold::Contact, &stats);

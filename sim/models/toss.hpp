@@ -12,6 +12,8 @@
 
 namespace dicesim {
 
+class StepObserver;  // sim/dynamics/contact_stepper.hpp
+
 enum class TossStatus : std::uint8_t {
   Settled = 0,     // ended by the fidelity's rule; face is the answer
   Unresolved = 1,  // hit the bounce or time cap, or chattered (Zeno): no answer, counted
@@ -95,6 +97,7 @@ struct TossProbe {
   std::uint64_t short_steps = 0;       // flat dice, `impulse`: fixed steps whose full length was below contact_step
   std::uint64_t rise_dropped = 0;      // flat dice, `impulse`: fixed steps whose held corners' rise would gain energy
   RigidState* final_state = nullptr;           // impulse, stepped: the state when the toss ended
+  StepObserver* steps_observer = nullptr;      // impulse, stepped: every state of the fixed steps (contact_stepper.hpp)
 };
 
 // Times one phase of a toss into probe->phase_s while in scope; reads no clock (and costs one
