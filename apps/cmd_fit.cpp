@@ -77,9 +77,14 @@ int run_fit_pass(const std::vector<FitParam>& params, const std::vector<FitData>
       status["stage_points"] = inc.stage_points;
       status["missing"] = inc.missing;
       break;
+    } catch (const std::runtime_error&) {
+      if (!InterruptGuard::interrupted()) throw;
+      // The block being tossed is lost (no part written); the parts written stay valid.
+      std::fprintf(stderr, "dicesim fit: interrupted; %zu part%s written, the block in progress not (run the pass again)\n",
+                   written.size(), written.size() == 1 ? "" : "s");
+      return kExitInterrupted;
     }
   }
-  if (InterruptGuard::interrupted()) return kExitInterrupted;
   status["written"] = written;
   if (a.json) {
     std::printf("%s\n", nlohmann::json{{"fit_pass", status}}.dump().c_str());
