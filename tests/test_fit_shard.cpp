@@ -125,6 +125,9 @@ TEST(CliFitShard, MergeRefusesMissingOverlappingAndOtherFitsPartsNamingTheFile) 
   expect_bad_input(run_dicesim(fit_args(3) + " --merge " + mixed), {stranger.c_str(), "seed"});
   // A pass of another N into the same directory.
   expect_bad_input(run_dicesim(fit_args(3) + " --points 0/2 --parts " + parts_dir()), {"shard count N", "fit-part-s0-0of3.json"});
+  // `dicesim merge` (of toss shards) given a fit part says how to merge it.
+  const std::string part = (fs::path(parts_dir()) / "fit-part-s0-0of3.json").string();
+  expect_bad_input(run_dicesim("merge " + part), {part.c_str(), "fit ARGS --merge"});
   // Nothing to merge; half a pass's options; a bad shard.
   const std::string empty = unique_temp("fit-empty");
   fs::create_directories(empty);
