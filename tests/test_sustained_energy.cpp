@@ -65,14 +65,15 @@ TEST(SustainedEnergy, NoStepRaisesPlainEnergyBeyondTheHeldDepth) {
   }
 }
 
-// The same promise for the leapfrog steps of error-controlled length (sim.contact_tol, polyhedra
-// in `impulse`), each step's true energies compared (the start's after the closing half kick, the
-// end's with its own still owed). NOT MET (why sim.contact_tol is experimental and off): measured
-// 2026-11-29 (lead), 485 of these 1 080 tosses have a step whose plain energy rises beyond the held
-// depth, by up to 8.8e-4 r (Die 1, d20, fair, d4; worst at e = 0). With half kicks the support
-// solve's impulse does work against the owed half kick ((g d / 2) P_z), which the fixed step's
-// argument (the whole kick before the solve) does not cover.
-TEST(SustainedEnergy, DISABLED_LeapfrogStepsRaisePlainEnergyNoMoreThanTheHeldDepth) {
+// The leapfrog steps of error-controlled length (sim.contact_tol, polyhedra in `impulse`):
+// drift-kick-drift, the support solve at the step's middle. A velocity-level plastic solve inside
+// a symmetric splitting is not dissipative without condition: with the kick g d before it, the
+// step changes E by dKE_solve + (g d / 2) P_z, at most m (g d)^2 / 8 (a held corner leaving the
+// floor at g d / 2 at the middle: FixedStepper::split_gain). That bound, derived in
+// docs/fidelity.md "Energy in sustained contact", is what this test holds the steps to, with the
+// held depth as for fixed steps. (Kick-drift-kick with merged half kicks failed it in 485 of these
+// 1 080 tosses: its true E owes the closing half kick.)
+TEST(SustainedEnergy, LeapfrogStepsRaisePlainEnergyNoMoreThanTheSplitBound) {
   std::uint64_t steps = 0;
   for (const char* scene : {"scenes/paper/die1.toml", "scenes/fair.toml", "scenes/dice/d20.toml", "scenes/dice/d4.toml"}) {
     for (double e : {0.0, 0.5, 1.0}) {
@@ -84,14 +85,17 @@ TEST(SustainedEnergy, DISABLED_LeapfrogStepsRaisePlainEnergyNoMoreThanTheHeldDep
         def.floor.friction = mu;
         def.sim.max_time = 4.0;
         const DieModel m = compile(def);
+        const double h = m.contact_step;  // the ceiling: no step is longer
+        const double split = m.gravity * h * h / 8.0;  // m (g h)^2 / 8 as a height
         for (int i = 0; i < 30; ++i) {
           TossProbe probe;
           toss(m, 39, static_cast<std::uint64_t>(i), &probe);
           steps += probe.steps;
           const std::string what = std::string(scene) + " e " + std::to_string(e) + " mu " + std::to_string(mu) +
                                    " toss " + std::to_string(i);
+          // Each step against its own length's bound, to rounding.
           EXPECT_LE(probe.max_rise_excess, 1e-12) << what;
-          const double bound = std::max(probe.max_held_sink, 1e-7 * m.bounding_radius) + 1e-12 * 4.0;
+          const double bound = std::max(probe.max_held_sink, 1e-7 * m.bounding_radius) + split + 1e-12 * 4.0;
           EXPECT_LE(probe.max_step_rise, bound) << what << " rise/r " << probe.max_step_rise / m.bounding_radius;
         }
       }

@@ -1,6 +1,6 @@
 // `impulse`'s sustained phase as leapfrog steps of error-controlled length (AdaptiveSteps in
-// contact_stepper.hpp): the step's closing half kick, and the next step's length from how much the
-// contact's mean force and torque changed over the last step.
+// contact_stepper.hpp): the next step's length from how much the contact's mean force and torque
+// changed over the last step.
 #include <algorithm>
 #include <cmath>
 
@@ -10,10 +10,9 @@ namespace dicesim {
 
 void FixedStepper::adapt(const RigidState& s0, const RigidState& s, double dt) {
   const DieModel& m = *m_;
-  kick_carry_ = dt;
   if (!(dt > 0.0)) return;
-  // What changed the momenta over the step besides the half kick before its solve: the contact.
-  const Vec3 F = m.mass * ((s.velocity - s0.velocity) / dt + Vec3(0.0, 0.0, kick_g_));
+  // What changed the momenta over the step besides gravity's kick: the contact.
+  const Vec3 F = m.mass * ((s.velocity - s0.velocity) / dt + Vec3(0.0, 0.0, m.gravity));
   const Vec3 T = (world_inertia(m, s.R) * s.omega - Iw_start_ * s0.omega) / dt;
   if (have_force_) {
     const double r = m.bounding_radius;
@@ -26,11 +25,6 @@ void FixedStepper::adapt(const RigidState& s0, const RigidState& s, double dt) {
   force_ = F;
   torque_ = T;
   have_force_ = true;
-}
-
-void FixedStepper::finish_phase(RigidState& s) {
-  s.velocity.z() -= kick_g_ * kick_carry_;
-  kick_carry_ = 0.0;
 }
 
 }  // namespace dicesim

@@ -187,9 +187,12 @@ double FixedStepper::hermite_start(double miss, double lo, double hi, double x) 
   // The cubic in powers of t: base + v t + H(t) + g (h - t) t + (miss + rate t) t (h - t).
   const double h = h_, g = kick_g_;
   const double q0 = hq_[0], p0 = hq_[1], q1 = hq_[2], p1 = hq_[3];
+  // The kick's powers of t (model_kick): g h t - g t^2, or leapfrog's (g h + model_slope_) t - g t^2 / 2.
+  const double k1 = leapfrog() ? g * h + model_slope_ : g * h;
+  const double k2 = leapfrog() ? 0.5 * g : g;
   const double c0 = full_p_.z() - m_->rounding + q0;
-  const double c1 = full_v_.z() + p0 + g * h + miss * h;
-  const double c2 = (3.0 * (q1 - q0) / h - 2.0 * p0 - p1) / h - g - miss + miss_rate_ * h;
+  const double c1 = full_v_.z() + p0 + k1 + miss * h;
+  const double c2 = (3.0 * (q1 - q0) / h - 2.0 * p0 - p1) / h - k2 - miss + miss_rate_ * h;
   const double c3 = ((2.0 * (q0 - q1) / h + p0 + p1) / h) / h - miss_rate_;
   const auto cubic = [&](double t, double& df) {
     df = c1 + t * (2.0 * c2 + 3.0 * c3 * t);
@@ -239,12 +242,13 @@ double FixedStepper::model_root(const ContactSet& c, double miss, double lo, dou
       Vec3 z_rate;
       const Vec3 z_row = rot.bottom_row(x, z_rate);
       double slope = 0.0;
-      g_model = lowest_flat(c, full_p_, full_v_, z_row, z_rate, x, slope) + kick_g_ * (h_ - x) * x;
+      double kick_slope;
+      g_model = lowest_flat(c, full_p_, full_v_, z_row, z_rate, x, slope) + model_kick(x, kick_slope);
       const double f = corrected(g_model, miss, x);
       if (std::abs(f) <= tol) break;
       (f > 0.0 ? lo : hi) = x;
       if (!(hi - lo > 1e-15 * h_)) break;
-      const double dg = slope + kick_g_ * (h_ - 2.0 * x);  // the model's own slope
+      const double dg = slope + kick_slope;  // the model's own slope
       const double delta = -f / (dg + (miss + miss_rate_ * x) * (h_ - 2.0 * x) + miss_rate_ * x * (h_ - x));
       const double next = x + delta;
       if (!(next > lo && next < hi)) {

@@ -24,7 +24,7 @@ FixedStepper::FixedStepper(const DieModel& m, double h, ImpactThreshold threshol
       h_max_(h),
       adaptive_(adaptive),
       h_ctrl_(h),
-      kick_g_(adaptive.tol > 0.0 ? 0.5 * m.gravity : m.gravity),
+      kick_g_(m.gravity),
       h_(h),
       v_impact_(sustained_contact_speed(m, adaptive.threshold_step > 0.0 ? adaptive.threshold_step : h)),
       touch_tol_(1e-7 * m.bounding_radius),
@@ -66,11 +66,6 @@ int FixedStepper::step(RigidState& s) { return step(s, kinetic_energy(*m_, s)); 
 
 int FixedStepper::step(RigidState& s, double ke) {
   const DieModel& m = *m_;
-  if (kick_carry_ > 0.0) {  // the last step's closing half kick, before this one's impact
-    s.velocity.z() -= kick_g_ * kick_carry_;
-    kick_carry_ = 0.0;
-    ke = kinetic_energy(m, s);
-  }
   ContactSet c;
   if (s.position.z() <= m.bounding_radius + touch_tol_ && !(soa_vertices_ > 0 && soa_touching(s, c)))
     c = touching_corners(m, s, touch_tol_);
@@ -102,6 +97,7 @@ int FixedStepper::step(RigidState& s, double ke) {
   }
   // After the impact: every trial's energy check starts here (without one, s0 is s: E0).
   e_start_ = impact_ ? mechanical_energy(m, s0) : E0;
+  if (leapfrog()) start_rot_.emplace(moments_, s0.R, Vec3(Iw_start_ * s0.omega), true);
   rims_new_ = false;
   slap_rims_ = 0;
   miss_rate_ = 0.0;
@@ -465,28 +461,22 @@ int FixedStepper::step(RigidState& s, double ke) {
   slap_located_ = rims_new_ && dt < h_;
   if (slap_rims_ != 0 && dt < h_) ++slaps;
   end_ke_ = kinetic_energy(m, s);
-  // The energy checks below compare true energies: a leapfrog step ends with its closing half
-  // kick still owed (adapt() set it), which the start's energy already had.
-  double ke_end = end_ke_;
-  if (kick_carry_ > 0.0) {
-    RigidState end = s;
-    end.velocity.z() -= kick_g_ * kick_carry_;
-    ke_end = kinetic_energy(m, end);
-  }
+  const double ke_end = end_ke_;
   if (a.risen) {
     // A step whose held corners rose: no gain in the rest rules' energy, which adds the deepest
     // corner's depth to the COM height (try_step's check).
     max_energy_gain =
-        std::max(max_energy_gain, relative_gain(E0 + m.mass * m.gravity * start_depth_max_, a.held_e));
+        std::max(max_energy_gain, relative_gain(E0 + m.mass * m.gravity * start_depth_max_ + split_gain(dt), a.held_e));
   } else {
-    max_energy_gain = std::max(max_energy_gain, relative_gain(E0, ke_end + m.mass * m.gravity * s.position.z()));
+    max_energy_gain =
+        std::max(max_energy_gain, relative_gain(E0 + split_gain(dt), ke_end + m.mass * m.gravity * s.position.z()));
   }
   {
     // Plain E over the step (the lifts below are counted corrections, not the step's).
     const double mg = m.mass * m.gravity;
     const double plain = ke_end + mg * s.position.z();
     max_step_rise = std::max(max_step_rise, (plain - E0) / mg);
-    max_rise_excess = std::max(max_rise_excess, relative_gain(E0 + mg * start_depth_max_, plain));
+    max_rise_excess = std::max(max_rise_excess, relative_gain(E0 + mg * start_depth_max_ + split_gain(dt), plain));
   }
   if (a.rise_dropped) ++rise_dropped;
   if (!m.curved() && a.G < -touch_tol_) {

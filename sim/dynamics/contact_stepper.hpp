@@ -52,15 +52,19 @@ inline double sustained_contact_speed(const DieModel& m, double h) { return 4.0 
 // that depth is within this bound (FixedStepper's max_sink): 1e-4 of the bounding radius.
 inline double held_corner_sink(const DieModel& m) { return 1e-4 * m.bounding_radius; }
 
-// `impulse`'s sustained phase (tol > 0): leapfrog steps whose length an error estimate chooses.
-// Gravity is kicked in halves, one at each end of a step (the kick at a step's end and the next
-// one's start are applied together, before that step's impact and support solve), so the free
-// motion between the solves is second order (the half kick still owed when the phase ends is
-// given then: finish_phase). After each step, the contact's mean force and torque over it are
-// compared with the previous step's; the change, times (h^2 / 2) / m and (h^2 / 2) r / I_min, is
-// the position error of a body point that a step of length h makes where the contact force
-// changes (a corner lifting, sliding turning to sticking): the next step is the length at which
-// that estimate is tol r, within [floor, h] and at most double the last (a quarter at least).
+// `impulse`'s sustained phase (tol > 0): leapfrog steps whose length an error estimate chooses,
+// drift-kick-drift: the free motion for half the step, gravity's whole kick and the support solve
+// at the step's middle, the free motion for the other half (try_step_dkd). Every step starts and
+// ends with a true velocity, so its length may change from one step to the next, and a step's
+// energy obeys the fixed step's argument with the solve at the middle (docs/fidelity.md "Energy in
+// sustained contact"). (Kick-drift-kick with the support solve at the start, tried first, gains
+// m_eff (g h)^2 / 8 whenever a corner the solve held lifts off within the step: the opening
+// half kick's impulse lifts the COM through the whole step, and nothing resists the closing half.)
+// After each step, the contact's mean force and torque over it are compared with the previous
+// step's; the change, times (h^2 / 2) / m and (h^2 / 2) r / I_min, is the position error of a body
+// point that a step of length h makes where the contact force changes (a corner lifting, sliding
+// turning to sticking): the next step is the length at which that estimate is tol r, within
+// [floor, h] and at most double the last (a quarter at least).
 // tol = 0: fixed steps of h (first order), as `stepped`.
 // The impact threshold is then 4 g threshold_step, a fixed speed (the shape's default contact step,
 // DieModel::sustained_step), not 4 g h: the ceiling h may change without changing the physics.
@@ -102,9 +106,7 @@ class FixedStepper {
   long long coast(RigidState& s, double& t, double max_time, long long max_k) const;
 
   double h() const { return h_max_; }
-  // Adaptive steps: the half kick owed at the end of the last step (s.velocity.z() -= g times it),
-  // applied and cleared; the length the next step will have (before location or max_sink).
-  void finish_phase(RigidState& s);
+  // Adaptive steps: the length the next step will have (before location or max_sink).
   double next_step() const { return h_ctrl_; }
   double last_dt() const { return dt_; }
   int impacts = 0;                // steps whose contact solve had restitution
@@ -164,10 +166,17 @@ class FixedStepper {
   std::uint64_t rise_dropped = 0;        // flat dice, max_sink: steps whose held corners' rise would gain energy (plain)
 
  private:
-  // Adaptive: the closing half kick owed, and the next step's length from this step's mean contact
-  // force and torque against the last step's (AdaptiveSteps). s0: the step's start after its impact.
+  // Adaptive: the next step's length from this step's mean contact force and torque against the
+  // last step's (AdaptiveSteps). s0: the step's start after its impact.
   void adapt(const RigidState& s0, const RigidState& s, double dt);
-  bool kick_carry_owed() const { return adaptive_.tol > 0.0; }  // leapfrog: every step ends owing a half kick
+  bool leapfrog() const { return adaptive_.tol > 0.0; }  // drift-kick-drift (try_step_dkd)
+  // The most a leapfrog step of length d may raise E = kinetic + m g z_COM (docs/fidelity.md
+  // "Energy in sustained contact"): m (g d)^2 / 8, reached where a held corner leaves the floor at
+  // half the kick's speed at the step's middle. 0 for fixed steps (their solve after the whole kick
+  // never gains).
+  double split_gain(double d) const {
+    return leapfrog() ? 0.125 * m_->mass * (m_->gravity * d) * (m_->gravity * d) : 0.0;
+  }
   // The longest step (<= h_max_) whose held corners, moving with the die's free rotation from the
   // step's start, sink no more than max_sink_ below the floor within it (to second order in d;
   // what try_step's rise does not hold); sets a_down_.
@@ -199,6 +208,11 @@ class FixedStepper {
     double held_e = 0.0;  // risen: held_energy of s (its check in try_step_with)
   };
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
+  // try_step_with's leapfrog step (a flat die): the free motion of s0 for d / 2 (start_rot_), the
+  // kick g d and the support solve (held corners asked to rise at bias) there, the free motion of
+  // the result for d / 2. full: also the location model's free motion (model_G: from s0 with the
+  // solve's velocities, an approximation the trials correct). Sets a.G at the end.
+  void try_step_dkd(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full, double bias);
   // A curved die lying flat to within the strike tolerance: its face's tripod added to c (also
   // when each tripod point lies within `depth` or reaches the floor within `window`: step()).
   // either: one tripod point joining suffices (both are added; step()'s kind B re-decision).
@@ -217,6 +231,8 @@ class FixedStepper {
   // try_step with the held corners asked to rise at `bias` (m/s, 0: none); false if that gains
   // energy (kinetic + m g (COM height + the deepest corner's depth)).
   bool try_step_with(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full, double bias);
+  // Its fixed (first-order) step: the kick g d and the support solve at s0, then the free motion for d.
+  void try_step_fixed(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full, double bias);
   // A curved die's support solve for a step of length d (gravity's kick already in s): the plastic
   // solve, rolling and pivoting resistance, and the touching rims' lowest points held on the floor
   // at the step's end by the curvature impulse at the step's middle (rim_support.cpp). Leaves
@@ -234,8 +250,23 @@ class FixedStepper {
   // the smaller gravity kick of a step of length t changes, g (h - t) t. Exact for a step without
   // contact (the rotation is the same); with contact the solve absorbs part of the kick.
   double model_G(const ContactSet& c, double t) const {
-    return lowest_new(c, full_p_, full_v_, *full_rot_, t) + kick_g_ * (h_ - t) * t;
+    double slope;
+    return lowest_new(c, full_p_, full_v_, *full_rot_, t) + model_kick(t, slope);
   }
+  // model_G's term for the kick, and its slope in t: fixed steps g (h - t) t (the kick g t comes
+  // before the motion); leapfrog g (2 h - t) t / 2 (a step of length t kicks at t / 2: exact
+  // without contact) + model_slope_ t.
+  double model_kick(double t, double& slope) const {
+    if (!leapfrog()) {
+      slope = kick_g_ * (h_ - 2.0 * t);
+      return kick_g_ * (h_ - t) * t;
+    }
+    slope = kick_g_ * (h_ - t) + model_slope_;
+    return 0.5 * kick_g_ * (2.0 * h_ - t) * t + model_slope_ * t;
+  }
+  // Leapfrog: what makes model_G exact at the full step too (its G less the model's there, / h; the
+  // model is of a kick before the motion, the step's kick is at its middle). 0: fixed steps.
+  double model_slope_ = 0.0;
   // The model corrected by a trial's miss: model_G(t) + (miss + miss_rate_ t) t (h - t) (the model
   // is exact at t = 0, the step's start, and at t = h, the full step itself; miss_rate_, 0 unless
   // predicted_miss set it, the miss's first-order change as the arriving corner turns).
@@ -293,8 +324,7 @@ class FixedStepper {
   double h_max_;  // the contact step h (thresholds, coast; adaptive: the ceiling)
   AdaptiveSteps adaptive_;
   double h_ctrl_;            // adaptive: the next step's length from the error estimate (else h_max_)
-  double kick_g_;            // the kick per unit step length before a step's solve: g (fixed steps) or g / 2
-  double kick_carry_ = 0.0;  // adaptive: the step length whose half kick is owed (the last step's)
+  double kick_g_;            // the kick per unit step length before a step's solve: g
   bool have_force_ = false;  // adaptive: force_/torque_ hold the last step's mean contact force
   Vec3 force_ = Vec3::Zero(), torque_ = Vec3::Zero();
   double h_;      // the current step's full length (h_max_, or shorter for max_sink_)
@@ -320,6 +350,7 @@ class FixedStepper {
   ContactGeometry geo_;   // the contact set-up of the current step (shared by its solves)
   std::optional<TorqueFreeRotation> full_rot_;   // the full step's free motion (model_G)
   std::optional<TorqueFreeRotation> trial_rot_;  // a shortened trial's
+  std::optional<TorqueFreeRotation> start_rot_;  // leapfrog: the step's start's free motion (every trial's first half)
   Vec3 full_p_ = Vec3::Zero(), full_v_ = Vec3::Zero();
   Vec3 full_w_ = Vec3::Zero();
   double miss_rate_ = 0.0;

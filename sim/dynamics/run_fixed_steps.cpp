@@ -29,7 +29,6 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
   std::uint64_t steps = 0;
   const auto finish = [&](StepperExit exit) {
     out.exit = exit;
-    st.finish_phase(s);  // adaptive: the half kick still owed (a lift-off's flight starts from the true velocity)
     impacts = st.impacts;
     if (stats) {
       stats->corrections.add(st.corrections);

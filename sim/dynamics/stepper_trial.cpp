@@ -50,6 +50,19 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
 
 bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full,
                                  double bias) {
+  if (leapfrog()) {
+    try_step_dkd(s0, c, d, a, full, bias);
+  } else {
+    try_step_fixed(s0, c, d, a, full, bias);
+  }
+  if (!(bias > 0.0)) return true;
+  // (New corners below the floor are the located step's business.)
+  a.held_e = held_energy(a.s, c);
+  return a.held_e <= e_start_ + m_->mass * m_->gravity * start_depth_max_ + split_gain(d);
+}
+
+void FixedStepper::try_step_fixed(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full,
+                                  double bias) {
   const DieModel& m = *m_;
   // The impact (solved once per step in step(): it does not depend on d) is already in s0.
   a.s = s0;
@@ -105,18 +118,57 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   else
     a.G = lowest_flat(c, p, v, s.R.row(2).transpose(), d);
   s.position = p + d * v;
-  if (!(bias > 0.0)) return true;
-  // (New corners below the floor are the located step's business.)
-  // Adaptive (leapfrog): s's velocity is the step's middle one; the energy at its end, comparable
-  // with the start's (the true velocity, after the closing half kick), has that kick too.
-  if (kick_carry_owed()) {
-    RigidState end = s;
-    end.velocity.z() -= kick_g_ * d;
-    a.held_e = held_energy(end, c);
+}
+
+void FixedStepper::try_step_dkd(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full,
+                                double bias) {
+  const DieModel& m = *m_;
+  a.s = s0;
+  RigidState& s = a.s;
+  a.impact = impact_;
+  if (impact_) a.imp = imp_;
+  a.next.n = 0;
+  a.capped = a.clamped = a.unreflected = false;
+  a.risen = bias > 0.0;
+  a.rise_dropped = false;
+  const double half = 0.5 * d;
+  std::optional<TorqueFreeRotation>& slot = full ? full_rot_ : trial_rot_;
+  if (c.n == 0) {
+    // No solve: the whole step is free motion, gravity's parabola exactly.
+    start_rot_->state(d, s.R, s.omega);
+    s.position = s0.position + d * s0.velocity;
+    s.position.z() -= 0.5 * kick_g_ * d * d;
+    s.velocity.z() -= kick_g_ * d;
+    if (full) {
+      full_p_ = s0.position;
+      full_v_ = s.velocity;
+      full_w_ = s0.omega;
+      slot.emplace(moments_, s0.R, Vec3(Iw_start_ * s0.omega), true);
+    }
   } else {
-    a.held_e = held_energy(s, c);
+    start_rot_->state(half, s.R, s.omega);
+    s.position = s0.position + half * s0.velocity;
+    s.velocity.z() -= kick_g_ * d;
+    s.velocity.z() -= bias;
+    a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next);
+    s.velocity.z() += bias;
+    if (full) {
+      full_p_ = s0.position;
+      full_v_ = s.velocity;
+      full_w_ = s.omega;
+      // The location model: s0's free motion with the solve's momenta (the trials correct it).
+      slot.emplace(moments_, s0.R, Vec3(world_inertia(m, s.R) * s.omega), true);
+    }
+    const TorqueFreeRotation second(moments_, s.R, Vec3(world_inertia(m, s.R) * s.omega), false);
+    second.state(half, s.R, s.omega);
+    s.position += half * s.velocity;
   }
-  return a.held_e <= e_start_ + m.mass * m.gravity * start_depth_max_;
+  rot_start_ = s0.R;
+  a.G = lowest_flat(c, s.position, Vec3::Zero(), s.R.row(2).transpose(), 0.0);
+  if (full) {
+    model_slope_ = 0.0;
+    if (d > 0.0) model_slope_ = (a.G - model_G(c, d)) / d;
+  }
 }
 
 double FixedStepper::predicted_step(const RigidState& s0, const ContactSet& c) {

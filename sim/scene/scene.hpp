@@ -159,10 +159,11 @@ inline constexpr double kContactStepCurved = 1e-3;
 // estimated position error of any body point, relative to the die's bounding radius; the contact
 // step above is then the ceiling, kContactStepFloor the floor (located steps, which end at a new
 // contact's instant, may be shorter). 0 (the default): fixed first-order steps of the contact step.
-// Experimental, not the default: its steps do not keep the energy statement (a step's plain energy
-// rose up to 8.8e-4 r beyond the held depth), rise_dropped fires ~1 in 7 tosses, and on Die 1 it
-// leaves the face distribution where fixed 3 ms steps put it (2*10^4 tosses: at most 21 outcomes
-// differ) at 2.5x the cost (docs/fidelity.md, "Sustained contact"). Curved dice ignore it.
+// Experimental, not the default: a rocking die's landing does not converge monotonically with the
+// tolerance (0.5-1.5 % low at some), its energy bound is m (g h)^2 / 8 a step rather than rounding,
+// and on Die 1 it leaves the face distribution where fixed 3 ms steps put it (2*10^4 tosses: at
+// most 26 outcomes differ) at 2.4-2.9x the cost (docs/fidelity.md, "Sustained contact"). Curved
+// dice ignore it.
 inline constexpr double kContactTolDefault = 0.0;
 inline constexpr double kContactStepFloor = 1e-4;
 
