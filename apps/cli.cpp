@@ -8,6 +8,7 @@
 #include "aggregator/checkpoint.hpp"
 #include "apps/commands.hpp"
 #include "apps/provenance.hpp"
+#include "apps/shard_file.hpp"
 #include "apps/fidelity_name.hpp"
 #include "apps/number_forms.hpp"
 #include "messages/auth.hpp"
@@ -74,6 +75,9 @@ int parse_and_run(CLI::App& app, int argc, char** argv, const int& exit_code) {
     std::fprintf(stderr, "dicesim: error: %s\n", e.what());
     return kExitBadInput;
   } catch (const agg::CheckpointError& e) {
+    std::fprintf(stderr, "dicesim: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const ShardError& e) {  // shard and fit part files (fit --points/--merge)
     std::fprintf(stderr, "dicesim: error: %s\n", e.what());
     return kExitBadInput;
   } catch (const std::exception& e) {

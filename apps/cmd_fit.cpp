@@ -13,6 +13,7 @@
 #include "apps/commands.hpp"
 #include "apps/fidelity_name.hpp"
 #include "apps/fit_json.hpp"
+#include "apps/fit_parts.hpp"
 #include "apps/gnuplot.hpp"
 #include "apps/interrupt.hpp"
 #include "apps/output_path.hpp"
@@ -36,7 +37,70 @@ struct FitArgs {
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   bool json = false;
   std::string plot;
+  std::string points;  // --points I/N: one shard's pass of a fit sharded by point (with --parts DIR)
+  std::string parts;
+  std::string merge;   // --merge DIR: the fit from its parts
 };
+
+// One shard's pass (fit --points I/N --parts DIR): tosses this shard's block of the first stage not
+// yet counted in DIR, writes it as a part, and goes on while the stage it finished is then whole
+// (the other shards' parts already there); stops at a stage that waits for other shards.
+int run_fit_pass(const std::vector<FitParam>& params, const std::vector<FitData>& data, FitOptions opt, const FitArgs& a) {
+  Shard shard;
+  try {
+    shard = parse_shard(a.points);
+  } catch (const std::invalid_argument& e) {
+    throw SceneError("dicesim fit", "--points", a.points, e.what());
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(a.parts, ec);
+  if (!std::filesystem::is_directory(a.parts)) throw SceneError("dicesim fit", "--parts", a.parts, "cannot create this directory");
+  const nlohmann::json identity = fit_identity(params, data, opt);
+  opt.toss_shard = shard;
+  std::vector<std::string> written;
+  nlohmann::json status = {{"shard", a.points}, {"parts", a.parts}};
+  const InterruptGuard interrupt;
+  opt.cancel = InterruptGuard::flag();
+  for (;;) {
+    const FitParts parts = read_fit_parts(a.parts, identity, shard.count);
+    opt.given = &parts.points;
+    try {
+      (void)run_fit(params, data, opt);
+      status["complete"] = true;
+      break;
+    } catch (const FitStageIncomplete& inc) {
+      if (!inc.tossed.empty()) written.push_back(write_fit_part(a.parts, identity, shard, inc));
+      if (!inc.tossed.empty() && inc.missing.empty()) continue;  // that stage is whole now: on to the next
+      status["complete"] = false;
+      status["stage"] = inc.stage;
+      status["label"] = inc.label;
+      status["stage_points"] = inc.stage_points;
+      status["missing"] = inc.missing;
+      break;
+    } catch (const std::runtime_error&) {
+      if (!InterruptGuard::interrupted()) throw;
+      // The block being tossed is lost (no part written); the parts written stay valid.
+      std::fprintf(stderr, "dicesim fit: interrupted; %zu part%s written, the block in progress not (run the pass again)\n",
+                   written.size(), written.size() == 1 ? "" : "s");
+      return kExitInterrupted;
+    }
+  }
+  status["written"] = written;
+  if (a.json) {
+    std::printf("%s\n", nlohmann::json{{"fit_pass", status}}.dump().c_str());
+    return kExitOk;
+  }
+  std::printf("dicesim fit: shard %s of a fit sharded by point, parts in %s\n", a.points.c_str(), a.parts.c_str());
+  for (const std::string& w : written) std::printf("  wrote %s\n", w.c_str());
+  if (status["complete"].get<bool>())
+    std::printf("every stage is counted: `dicesim fit ... --merge %s` (the same arguments) prints the fit\n", a.parts.c_str());
+  else
+    std::printf("stage %d (%s) waits for %zu of its %zu points from other shards: run every shard's pass again once they "
+                "have finished (a fit takes at most rounds + %d + 1 passes)\n",
+                status["stage"].get<int>(), status["label"].get<std::string>().c_str(), status["missing"].size(),
+                status["stage_points"].get<std::size_t>(), kFitMaxWidenings);
+  return kExitOk;
+}
 
 void write_profile_plot(const std::string& path, const FitResult& r) {
   std::ostringstream gp;
@@ -191,6 +255,19 @@ int run_fit_cmd(const FitArgs& a) {
   opt.threads = a.threads;
   opt.tosses = a.tosses;
   opt.rounds = a.rounds;
+  if (!a.points.empty() || !a.parts.empty()) {
+    if (a.points.empty() || a.parts.empty())
+      throw SceneError("dicesim fit", a.points.empty() ? "--parts" : "--points", a.points.empty() ? a.parts : a.points,
+                       "a shard's pass needs both --points I/N and --parts DIR");
+    if (!a.merge.empty()) throw SceneError("dicesim fit", "--merge", a.merge, "not with --points: a pass tosses, --merge reads");
+    if (!a.plot.empty()) throw SceneError("dicesim fit", "--plot", a.plot, "needs the whole fit: give it with --merge DIR");
+    return run_fit_pass(params, data, opt, a);
+  }
+  FitParts merged;
+  if (!a.merge.empty()) {  // every point from the parts: the fit of one unsharded run
+    merged = read_fit_parts(a.merge, fit_identity(params, data, opt), 0);
+    opt.given = &merged.points;
+  }
   ProgressBar bar;
   // Where the fit was when interrupted: a fit has no estimate before a round's whole grid is tossed.
   struct State {
@@ -210,6 +287,9 @@ int run_fit_cmd(const FitArgs& a) {
   FitResult r;
   try {
     r = run_fit(params, data, opt);
+  } catch (const FitStageIncomplete& inc) {
+    bar.finish();
+    throw ShardError(missing_parts_message(a.merge, merged.count, inc));
   } catch (const std::runtime_error&) {
     bar.finish();
     if (!InterruptGuard::interrupted()) throw;
@@ -264,6 +344,9 @@ void register_fit(CLI::App& app, int& exit_code) {
       "      --param floor.restitution=0.2:0.9 --param floor.friction=0.05:1 --fidelity impulse --json\n"
       "  dicesim fit scenes/paper/die1.toml --data my_counts.csv \\\n"
       "      --param materials.steel.density=2000:20000 --fidelity static --plot profile.svg\n"
+      "Sharded by point (e.g. a Slurm array of 4, each pass after the last; the same arguments each time):\n"
+      "  for pass in 1 2 3 4; do for i in 0 1 2 3; do dicesim fit ARGS --points $i/4 --parts parts/; done; done\n"
+      "  dicesim fit ARGS --merge parts/\n"
       "Exit codes: 0 fitted, 1 failed, 2 bad input (file, key, value or range named).");
   a->scene.add_to(cmd);
   cmd->add_option("--data", a->data, "Observed counts (CSV face,count or toss JSON); repeatable: the first is SCENE's")
@@ -287,6 +370,18 @@ void register_fit(CLI::App& app, int& exit_code) {
   cmd->add_flag("--json", a->json, "Print exactly one JSON object on stdout instead of the table");
   cmd->add_option("--plot", a->plot, "Write the profile likelihood(s) as a picture (.png or .svg; needs gnuplot)")
       ->type_name("FILE");
+  cmd->add_option("--points", a->points,
+                  "Shard the fit by point, for job arrays: toss shard I of N's block of the first stage (a round's\n"
+                  "design, then the fitted point) not yet counted in --parts DIR and write it there as a part. A\n"
+                  "stage needs the ones before it, so run the N shards' passes again after each other (at most\n"
+                  "rounds + 5 passes; a pass with nothing left to toss says so), then --merge DIR")
+      ->type_name("I/N");
+  cmd->add_option("--parts", a->parts, "With --points: the directory shared by the shards' part files (created)")
+      ->type_name("DIR");
+  cmd->add_option("--merge", a->merge,
+                  "Print the fit from the part files in DIR, exactly as one unsharded fit with the same arguments\n"
+                  "prints it; refuses (exit 2, naming the file) parts of another fit, missing and overlapping parts")
+      ->type_name("DIR");
   cmd->callback([a, &exit_code] { exit_code = run_fit_cmd(*a); });
 }
 

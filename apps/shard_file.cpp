@@ -2,6 +2,7 @@
 #include <algorithm>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -94,6 +95,9 @@ ShardPart read_shard_file(const std::string& file) {
   p.file = file;
   try {
     const nlohmann::json j = nlohmann::json::parse(in);
+    if (j.is_object() && j.contains("fit_part"))  // apps/fit_parts.hpp: merge needs the fit's arguments
+      throw ShardError(file + ": a part of a fit sharded by point, not of a toss: print the fit with dicesim fit ARGS --merge " +
+                       std::filesystem::path(file).parent_path().string() + " (the fit's own arguments)");
     if (!j.is_object() || !j.contains("shard"))
       throw ShardError(file + ": not a shard file (no \"shard\" key; write one with dicesim toss --shard I/N --out FILE)");
     const auto& s = j.at("shard");

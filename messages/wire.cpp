@@ -1,16 +1,50 @@
 #include "messages/wire.hpp"
 
+#include <arpa/inet.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <string_view>
 
 namespace dicesim::wire {
 
-std::string resolve_url(const std::string& flag) {
+namespace {
+
+// LCM 1.3.1's tcpq provider takes the hub's address as a dotted IPv4 only: a host name (a
+// Kubernetes Service, a cluster node) is not looked up, and every connect is refused. So the name
+// is looked up here (IPv4, as the provider connects), once, when the URL is resolved.
+std::string with_tcpq_address(const std::string& url) {
+  constexpr std::string_view kScheme = "tcpq://";
+  if (url.rfind(kScheme, 0) != 0) return url;
+  const std::size_t host_at = kScheme.size();
+  const std::size_t host_end = url.find_first_of(":/?", host_at);
+  const std::string host = url.substr(host_at, host_end == std::string::npos ? std::string::npos : host_end - host_at);
+  in_addr numeric{};
+  if (host.empty() || ::inet_pton(AF_INET, host.c_str(), &numeric) == 1) return url;
+  addrinfo hints{};
+  hints.ai_family = AF_INET;
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* found = nullptr;
+  if (::getaddrinfo(host.c_str(), nullptr, &hints, &found) != 0 || !found) return url;  // LCM says it cannot connect
+  char text[INET_ADDRSTRLEN] = {};
+  ::inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in*>(found->ai_addr)->sin_addr, text, sizeof text);
+  ::freeaddrinfo(found);
+  return std::string(kScheme) + text + (host_end == std::string::npos ? "" : url.substr(host_end));
+}
+
+std::string chosen_url(const std::string& flag) {
   if (!flag.empty()) return flag;
   if (const char* env = std::getenv("LCM_DEFAULT_URL"); env && *env) return env;
   return kDefaultUrl;
 }
+
+}  // namespace
+
+std::string resolve_url(const std::string& flag) { return with_tcpq_address(chosen_url(flag)); }
 
 std::int64_t now_utime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())

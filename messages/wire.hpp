@@ -27,7 +27,9 @@ inline constexpr const char* kProbabilities = "DICESIM_PROBABILITIES";
 // Host-confined (TTL 0: multicast never leaves this machine) when neither --lcm nor
 // LCM_DEFAULT_URL says otherwise.
 inline constexpr const char* kDefaultUrl = "udpm://239.255.76.67:7667?ttl=0";
-// --lcm URL, else $LCM_DEFAULT_URL, else kDefaultUrl.
+// --lcm URL, else $LCM_DEFAULT_URL, else kDefaultUrl. A tcpq://HOST:PORT's HOST given by name is
+// looked up (IPv4) and replaced by its address: LCM 1.3.1's tcpq provider connects to dotted
+// addresses only (a name, e.g. a Kubernetes Service's, was refused on every connect).
 std::string resolve_url(const std::string& flag);
 
 // A toss_batch carries at most kMaxBatch tosses: 6 bytes each, ~48 KB, one LCM datagram (under

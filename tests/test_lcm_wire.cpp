@@ -288,3 +288,13 @@ TEST(LcmWire, UrlPrecedence) {
   EXPECT_EQ(w::resolve_url("udpm://239.255.76.67:7001?ttl=1"), "udpm://239.255.76.67:7001?ttl=1");
   ::unsetenv("LCM_DEFAULT_URL");
 }
+
+// LCM's tcpq provider does not look names up (podman kube play of examples/kubernetes/live-run.yaml:
+// every worker's connect to tcpq://dicesim-hub:7700 was refused, tcpq://ADDRESS:7700 worked).
+TEST(LcmWire, TcpqHostNamesBecomeAddresses) {
+  EXPECT_EQ(w::resolve_url("tcpq://localhost:7700"), "tcpq://127.0.0.1:7700");  // /etc/hosts, no DNS
+  ::setenv("LCM_DEFAULT_URL", "tcpq://localhost:7701", 1);
+  EXPECT_EQ(w::resolve_url(""), "tcpq://127.0.0.1:7701");
+  ::unsetenv("LCM_DEFAULT_URL");
+  EXPECT_EQ(w::resolve_url("tcpq://127.0.0.1:7700"), "tcpq://127.0.0.1:7700");
+}

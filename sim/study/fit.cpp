@@ -211,6 +211,11 @@ class Fitter {
   std::vector<VectorXd> grid(const Box& box) const { return box_grid(box, fit_grid_points(d_)); }
   // Tosses every model with indices 0..tosses-1 in `batches` batches on the thread pool.
   std::vector<PointCounts> simulate(const std::vector<DieModel>& models, std::uint64_t tosses, const std::string& stage);
+  // One stage's counts, [data set][point], models[s][j] at points[j]: tossed here, or taken from
+  // opt_.given (a sharded fit: FitPointCounts, FitStageIncomplete).
+  std::vector<std::vector<PointCounts>> stage_counts(const std::vector<std::vector<DieModel>>& models,
+                                                     const std::vector<VectorXd>& points, std::uint64_t tosses,
+                                                     const std::string& label);
   Surrogate fit_surrogate(const Box& box, const std::vector<VectorXd>& design, const std::vector<std::vector<PointCounts>>& counts,
                           int skip_batch) const;
   FitParamResult profile_param(int i, const Surrogate& sur, const Box& box, const VectorXd& theta, double lmax,
@@ -232,7 +237,72 @@ class Fitter {
   std::uint64_t done_ = 0, total_ = 0;      // tosses, for progress
   std::uint64_t simulated_ = 0;
   std::uint64_t tosses_ = 0;               // per point in the last round
+  int stage_ = 0;                          // stages counted so far (FitPointCounts::stage)
 };
+
+std::vector<std::vector<PointCounts>> Fitter::stage_counts(const std::vector<std::vector<DieModel>>& models,
+                                                           const std::vector<VectorXd>& points, std::uint64_t tosses,
+                                                           const std::string& label) {
+  const int stage = stage_++;
+  const std::size_t S = models.size(), J = points.size();
+  std::vector<std::vector<PointCounts>> out(S);
+  if (!opt_.given) {
+    for (std::size_t s = 0; s < S; ++s) out[s] = simulate(models[s], tosses, label);
+    return out;
+  }
+  const auto B = static_cast<std::size_t>(opt_.batches);
+  std::vector<const FitPointCounts*> found(S * J, nullptr);
+  for (const FitPointCounts& g : *opt_.given) {
+    if (g.stage != stage) continue;
+    const std::string where = "stage " + std::to_string(stage) + " point " + std::to_string(g.point);
+    if (g.point >= S * J)
+      throw SceneError(g.origin, "point", where,
+                       "this fit's stage " + std::to_string(stage) + " has " + std::to_string(S * J) + " points (a part of another fit?)");
+    const std::size_t s = g.point / J, j = g.point % J;
+    bool same = g.tosses == tosses && g.theta.size() == static_cast<std::size_t>(d_) && g.faces.size() == B && g.settled.size() == B;
+    for (int i = 0; same && i < d_; ++i) same = g.theta[static_cast<std::size_t>(i)] == points[j][i];
+    for (std::size_t b = 0; same && b < B; ++b) same = g.faces[b].size() == labels_[s].size();
+    if (!same)
+      throw SceneError(g.origin, "point", where, "its keys' values, tosses or batches are not this fit's (a part of another fit?)");
+    if (found[g.point])
+      throw SceneError(g.origin, "point", where,
+                       "also counted in " + found[g.point]->origin + " (overlapping parts: each point may be counted once)");
+    found[g.point] = &g;
+  }
+  FitStageIncomplete inc;
+  inc.stage = stage;
+  inc.label = label;
+  inc.stage_points = S * J;
+  for (std::size_t f = 0; f < S * J; ++f)
+    if (!found[f]) inc.missing.push_back(f);
+  if (inc.missing.empty()) {
+    for (std::size_t f = 0; f < S * J; ++f) out[f / J].push_back({found[f]->faces, found[f]->settled});
+    simulated_ += tosses * S * J;  // as an unsharded fit counts them
+    return out;
+  }
+  if (opt_.toss_shard.count > 0) {  // a pass: this shard's block of the stage, then stop
+    const IndexRange block = shard_range(S * J, opt_.toss_shard);
+    std::vector<std::size_t> left;
+    for (const std::size_t f : inc.missing) {
+      if (f < block.first || f >= block.first + block.tosses) {
+        left.push_back(f);
+        continue;
+      }
+      const std::size_t s = f / J, j = f % J;
+      PointCounts pc = std::move(simulate({models[s][j]}, tosses, label)[0]);
+      FitPointCounts t;
+      t.stage = stage;
+      t.point = f;
+      t.theta.assign(points[j].data(), points[j].data() + points[j].size());
+      t.tosses = tosses;
+      t.faces = std::move(pc.faces);
+      t.settled = std::move(pc.settled);
+      inc.tossed.push_back(std::move(t));
+    }
+    inc.missing = std::move(left);
+  }
+  throw inc;
+}
 
 std::vector<PointCounts> Fitter::simulate(const std::vector<DieModel>& models, std::uint64_t tosses, const std::string& stage) {
   const int B = opt_.batches;
@@ -539,8 +609,7 @@ FitResult Fitter::run() {
       }
     }
     const std::string stage = "round " + std::to_string(r + 1) + "/" + std::to_string(R);
-    counts.assign(S, {});
-    for (std::size_t s = 0; s < S; ++s) counts[s] = simulate(models[s], round_tosses(r), stage);
+    counts = stage_counts(models, design, round_tosses(r), stage);
     if (r == 0) {
       // A key that moves no outcome beyond the noise cannot be fitted: say so, estimate nothing.
       res.params.clear();
@@ -704,15 +773,17 @@ FitResult Fitter::run() {
   // The fitted probabilities: simulated at the estimate, with the goodness of fit.
   double stat = 0.0;
   int dof = 0;
+  std::vector<std::vector<DieModel>> at(S);
+  for (std::size_t s = 0; s < S; ++s) at[s].push_back(model_at(s, theta));
+  const std::vector<std::vector<PointCounts>> fitted = stage_counts(at, {theta}, tosses_, "fitted");
   for (std::size_t s = 0; s < S; ++s) {
-    const std::vector<DieModel> at{model_at(s, theta)};
-    const PointCounts pc = simulate(at, tosses_, "fitted")[0];
+    const PointCounts& pc = fitted[s][0];
     FitDataResult dr;
     dr.scene = data_[s].scene;
     dr.overrides = data_[s].overrides;
     dr.source = data_[s].source;
     dr.labels = labels_[s];
-    if (at[0].outcome_labels == dr.labels) dr.names = outcome_names(at[0]);
+    if (at[s][0].outcome_labels == dr.labels) dr.names = outcome_names(at[s][0]);
     dr.fitted_tosses = tosses_;
     std::uint64_t settled = 0;
     std::vector<std::uint64_t> f(labels_[s].size(), 0);

@@ -26,10 +26,12 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "sim/study/compare.hpp"
+#include "sim/study/shard.hpp"
 #include "sim/study/statistics.hpp"
 
 namespace dicesim {
@@ -42,6 +44,36 @@ struct FitParam {
 
 // "KEY=LO:HI" (LO < HI, both finite). Throws SceneError naming `origin`, "--param" and the text.
 FitParam parse_fit_param(const std::string& text, const std::string& origin = "dicesim fit");
+
+// ---- A fit sharded by point (`dicesim fit --points I/N`, `--merge`) ----
+// A fit tosses in stages: each round's design (a round refitted in a widened box is a stage of its
+// own), then the fitted probabilities at the estimate. A stage's points are known only once the
+// stages before it are counted, so a sharded fit runs in passes: in each pass, shard I of N tosses
+// its block of the first stage not yet counted (the stage's points in order -- data set s's design
+// point j is s * J + j -- cut as shard_range cuts toss indices). Every point tosses indices
+// 0..tosses-1 with the fit's seed whatever else is tossed, so the points given back replay the
+// fit exactly: the same estimate, intervals and fitted probabilities as one unsharded fit.
+struct FitPointCounts {
+  int stage = 0;
+  std::size_t point = 0;      // in its stage
+  std::vector<double> theta;  // the fitted keys' values, in --param order
+  std::uint64_t tosses = 0;
+  std::vector<std::vector<std::uint64_t>> faces;  // [batch][outcome, in label order]
+  std::vector<std::uint64_t> settled;             // [batch]
+  std::string origin;         // where it was read (a part file), for messages
+};
+
+// Thrown by run_fit when FitOptions::given lacks a point of a stage: with toss_shard set, after
+// tossing that shard's block of the stage (`tossed`: a pass's part); without, nothing tossed (a
+// merge of incomplete parts).
+struct FitStageIncomplete : std::runtime_error {
+  FitStageIncomplete() : std::runtime_error("a stage of the sharded fit is not counted") {}
+  int stage = 0;
+  std::string label;                 // "round 2/3", "fitted"
+  std::size_t stage_points = 0;
+  std::vector<std::size_t> missing;  // points of the stage neither given nor tossed by this pass
+  std::vector<FitPointCounts> tossed;
+};
 
 // One data set: observed counts of one die in one scene.
 struct FitData {
@@ -63,6 +95,12 @@ struct FitOptions {
   // (stage, tosses done, tosses in the whole fit), from any thread, about every few hundred tosses.
   std::function<void(const std::string&, std::uint64_t, std::uint64_t)> progress;
   const std::atomic<bool>* cancel = nullptr;  // stops at the next job: run_fit then throws
+  // Sharded by point (FitPointCounts): points counted by earlier passes, taken instead of tossed
+  // (their keys' values and tosses must be the fit's: SceneError naming the origin). nullptr: an
+  // ordinary fit, every point tossed here. With `given`, the first stage not wholly given throws
+  // FitStageIncomplete, after tossing toss_shard's block of it when toss_shard.count > 0.
+  const std::vector<FitPointCounts>* given = nullptr;
+  Shard toss_shard{0, 0};
 };
 
 // The automatic tosses per point: 20 per observed toss of the largest data set, at least 40 000.

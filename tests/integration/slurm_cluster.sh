@@ -2,9 +2,12 @@
 # examples/slurm/ on a real one-node Slurm cluster that this script starts for itself: munged,
 # slurmctld and slurmd (Debian's munge and slurm-wlm) on loopback inside a private network
 # namespace, with a generated slurm.conf, all state in a temporary folder. Run by CTest:
-#   slurm_cluster.sh DICESIM_BINARY SHARDS TOSSES
+#   slurm_cluster.sh DICESIM_BINARY SHARDS TOSSES [fit]
 # The example's job array of SHARDS shards and its merge step (afterok dependency) must give the
-# counts of one `dicesim toss` of all TOSSES paper tosses. Under CI=true, not being able to run fails.
+# counts of one `dicesim toss` of all TOSSES paper tosses. With `fit`: examples/slurm/fit-submit.sh,
+# a fit (TOSSES per point) sharded by point in passes of SHARDS-task arrays, whose merge must print
+# exactly the unsharded `dicesim fit --json` but for elapsed_s and threads. Under CI=true, not
+# being able to run fails.
 set -euo pipefail
 [ -n "${DICESIM_TRACE:-}" ] && set -x
 
@@ -17,7 +20,7 @@ if [ "${DICESIM_NETNS:-}" != "1" ]; then
   unshare --net true 2> /dev/null || skip "cannot make a network namespace here (unshare --net failed)"
   exec unshare --net env DICESIM_NETNS=1 "$0" "$@"
 fi
-bin=$(readlink -f "$1") shards=$2 tosses=$3
+bin=$(readlink -f "$1") shards=$2 tosses=$3 mode=${4:-toss}
 for p in munged mungekey slurmctld slurmd sbatch squeue; do
   command -v "$p" > /dev/null || skip "no $p (Debian packages slurm-wlm and munge)"
 done
@@ -94,16 +97,42 @@ for ((t = 0; t < 300; t++)); do
 done
 sinfo -h -o '%T' | grep -qE '^idle' || fail "the node did not come up idle within 60 s: $(sinfo 2>&1)"
 
+wait_queue() {
+  for ((t = 0; t < 3000; t++)); do
+    [ -z "$(squeue -h 2> /dev/null)" ] && break
+    sleep 0.2
+  done
+  [ -z "$(squeue -h)" ] || fail "jobs still queued after 600 s: $(squeue)"
+}
+
+if [ "$mode" = fit ]; then
+  # Counts that put the estimate inside the range: later rounds' points depend on earlier ones.
+  printf 'face,count\n1,150\n2,170\n3,168\n4,166\n5,170\n6,176\n' > "$work/counts.csv"
+  fit_args="$src_dir/scenes/paper/die1.toml --data $work/counts.csv --data $work/counts.csv --scene $src_dir/scenes/paper/die2.toml"
+  fit_args+=" --param materials.steel.density=3000:20000 --fidelity static -n $tosses --seed 3"
+  # shellcheck disable=SC2086
+  "$bin" fit $fit_args -j 2 --json > "$work/ref-fit.json" 2> /dev/null
+  cd "$work/parts"
+  merge_job=$(FIT_ARGS="$fit_args" DICESIM="$bin" "$src_dir/examples/slurm/fit-submit.sh" "$shards" "$work/parts/fit")
+  echo "fit merge job $merge_job; waiting"
+  wait_queue
+  [ -s "$work/parts/fit/fit.json" ] || fail "the fit merge step wrote no fit.json ($(cat "$work/parts"/dicesim-fit-merge-*.log 2>&1))"
+  fstable() { jq -cS 'del(.elapsed_s, .provenance.threads)' "$1"; }
+  if [ "$(fstable "$work/ref-fit.json")" != "$(fstable "$work/parts/fit/fit.json")" ]; then
+    echo "fit:   $(fstable "$work/ref-fit.json")" >&2
+    echo "slurm: $(fstable "$work/parts/fit/fit.json")" >&2
+    fail "the Slurm-sharded fit differs from dicesim fit"
+  fi
+  echo "PASS [slurm fit]: $(ls "$work/parts/fit"/fit-part-*.json | wc -l) parts of $shards-task passes merged to dicesim fit's JSON"
+  exit 0
+fi
+
 # The reference, then the example exactly as a user submits it.
 "$bin" toss scenes/paper/die1.toml --tosses "$tosses" --seed 1 --threads 2 --json > "$work/ref.json"
 cd "$work/parts"
 merge_job=$(DICESIM="$bin" "$src_dir/examples/slurm/submit.sh" "$src_dir/scenes/paper/die1.toml" "$tosses" "$shards" "$work/parts")
 echo "merge job $merge_job; waiting"
-for ((t = 0; t < 3000; t++)); do
-  [ -z "$(squeue -h 2> /dev/null)" ] && break
-  sleep 0.2
-done
-[ -z "$(squeue -h)" ] || fail "jobs still queued after 600 s: $(squeue)"
+wait_queue
 [ "$(ls "$work/parts"/part-*.json | wc -l)" -eq "$shards" ] || fail "expected $shards part files: $(ls "$work/parts")"
 [ -s "$work/parts/run.json" ] || fail "the merge step wrote no run.json ($(cat "$work/parts"/dicesim-merge-*.log 2>&1))"
 stable() { sed -E 's/"scene":"[^"]*",?//g; s/"elapsed_s":[^,}]*,?//; s/"threads":[0-9]+,?//g; s/"tosses_per_s":[^,}]*,?//; s/"seconds":[^,}]*,?//g' "$1"; }  # threads: also provenance's
