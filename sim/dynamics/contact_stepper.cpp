@@ -461,7 +461,6 @@ int FixedStepper::step(RigidState& s, double ke) {
   slap_located_ = rims_new_ && dt < h_;
   if (slap_rims_ != 0 && dt < h_) ++slaps;
   end_ke_ = kinetic_energy(m, s);
-  const double ke_end = end_ke_;
   if (a.risen) {
     // A step whose held corners rose: no gain in the rest rules' energy, which adds the deepest
     // corner's depth to the COM height (try_step's check).
@@ -469,12 +468,12 @@ int FixedStepper::step(RigidState& s, double ke) {
         std::max(max_energy_gain, relative_gain(E0 + m.mass * m.gravity * start_depth_max_ + split_gain(dt), a.held_e));
   } else {
     max_energy_gain =
-        std::max(max_energy_gain, relative_gain(E0 + split_gain(dt), ke_end + m.mass * m.gravity * s.position.z()));
+        std::max(max_energy_gain, relative_gain(E0 + split_gain(dt), end_ke_ + m.mass * m.gravity * s.position.z()));
   }
   {
     // Plain E over the step (the lifts below are counted corrections, not the step's).
     const double mg = m.mass * m.gravity;
-    const double plain = ke_end + mg * s.position.z();
+    const double plain = end_ke_ + mg * s.position.z();
     max_step_rise = std::max(max_step_rise, (plain - E0) / mg);
     max_rise_excess = std::max(max_rise_excess, relative_gain(E0 + mg * start_depth_max_ + split_gain(dt), plain));
   }

@@ -208,7 +208,7 @@ class FixedStepper {
     double held_e = 0.0;  // risen: held_energy of s (its check in try_step_with)
   };
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
-  // try_step_with's leapfrog step (a flat die): the free motion of s0 for d / 2 (start_rot_), the
+  // try_step_with's leapfrog step from a.s = s0 (a flat die): the free motion for d / 2 (start_rot_), the
   // kick g d and the support solve (held corners asked to rise at bias) there, the free motion of
   // the result for d / 2. full: also the location model's free motion (model_G: from s0 with the
   // solve's velocities, an approximation the trials correct). Sets a.G at the end.
@@ -229,9 +229,11 @@ class FixedStepper {
   // while the impact leaves one approaching (step()'s rim strike).
   ImpactResult strike_rim(RigidState& s0, const ContactSet& c);
   // try_step with the held corners asked to rise at `bias` (m/s, 0: none); false if that gains
-  // energy (kinetic + m g (COM height + the deepest corner's depth)).
+  // energy (kinetic + m g (COM height + the deepest corner's depth), plus split_gain). Sets a to
+  // s0 and the step's impact with its flags cleared, then takes the step below that fits.
   bool try_step_with(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full, double bias);
-  // Its fixed (first-order) step: the kick g d and the support solve at s0, then the free motion for d.
+  // Its fixed (first-order) step from a.s = s0: the kick g d and the support solve there, then the
+  // free motion for d.
   void try_step_fixed(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full, double bias);
   // A curved die's support solve for a step of length d (gravity's kick already in s): the plastic
   // solve, rolling and pivoting resistance, and the touching rims' lowest points held on the floor

@@ -50,6 +50,14 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
 
 bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full,
                                  double bias) {
+  // The impact (solved once per step in step(): it does not depend on d) is already in s0.
+  a.s = s0;
+  a.impact = impact_;
+  if (impact_) a.imp = imp_;
+  a.next.n = 0;
+  a.capped = a.clamped = a.unreflected = false;
+  a.risen = bias > 0.0;
+  a.rise_dropped = false;
   if (leapfrog()) {
     try_step_dkd(s0, c, d, a, full, bias);
   } else {
@@ -64,17 +72,7 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
 void FixedStepper::try_step_fixed(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full,
                                   double bias) {
   const DieModel& m = *m_;
-  // The impact (solved once per step in step(): it does not depend on d) is already in s0.
-  a.s = s0;
   RigidState& s = a.s;
-  a.impact = impact_;
-  if (impact_) a.imp = imp_;
-  a.next.n = 0;
-  a.capped = false;
-  a.clamped = false;
-  a.unreflected = false;
-  a.risen = bias > 0.0;
-  a.rise_dropped = false;
   s.velocity.z() -= kick_g_ * d;
   // Built in place (the full step's is kept for model_G; the object is large, so no copies). A
   // curved die's support solve builds its own (rim_support: the rotation is part of its search).
@@ -123,14 +121,7 @@ void FixedStepper::try_step_fixed(const RigidState& s0, const ContactSet& c, dou
 void FixedStepper::try_step_dkd(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full,
                                 double bias) {
   const DieModel& m = *m_;
-  a.s = s0;
   RigidState& s = a.s;
-  a.impact = impact_;
-  if (impact_) a.imp = imp_;
-  a.next.n = 0;
-  a.capped = a.clamped = a.unreflected = false;
-  a.risen = bias > 0.0;
-  a.rise_dropped = false;
   const double half = 0.5 * d;
   std::optional<TorqueFreeRotation>& slot = full ? full_rot_ : trial_rot_;
   if (c.n == 0) {
@@ -143,7 +134,7 @@ void FixedStepper::try_step_dkd(const RigidState& s0, const ContactSet& c, doubl
       full_p_ = s0.position;
       full_v_ = s.velocity;
       full_w_ = s0.omega;
-      slot.emplace(moments_, s0.R, Vec3(Iw_start_ * s0.omega), true);
+      slot = start_rot_;  // the model's free motion is this motion
     }
   } else {
     start_rot_->state(half, s.R, s.omega);
@@ -152,14 +143,15 @@ void FixedStepper::try_step_dkd(const RigidState& s0, const ContactSet& c, doubl
     s.velocity.z() -= bias;
     a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next);
     s.velocity.z() += bias;
+    const Vec3 L = world_inertia(m, s.R) * s.omega;  // the solve's angular momentum, kept by the second half
     if (full) {
       full_p_ = s0.position;
       full_v_ = s.velocity;
       full_w_ = s.omega;
       // The location model: s0's free motion with the solve's momenta (the trials correct it).
-      slot.emplace(moments_, s0.R, Vec3(world_inertia(m, s.R) * s.omega), true);
+      slot.emplace(moments_, s0.R, L, true);
     }
-    const TorqueFreeRotation second(moments_, s.R, Vec3(world_inertia(m, s.R) * s.omega), false);
+    const TorqueFreeRotation second(moments_, s.R, L, false);
     second.state(half, s.R, s.omega);
     s.position += half * s.velocity;
   }
