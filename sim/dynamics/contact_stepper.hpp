@@ -360,6 +360,9 @@ class FixedStepper {
   // with no depth at the start it is linear in the step length, and the shortened steps' solves
   // see the kick g d plus it (predicted_miss).
   double full_bias_ = 0.0;
+  // Leapfrog: the held corners' tangential velocity at the step's middle (leapfrog_bias, the
+  // tangential part of the bias; try_step sets it for try_step_dkd's solve).
+  Eigen::Vector2d slip_bias_ = Eigen::Vector2d::Zero();
   bool hermite_ = false;  // hq_ holds the arriving corner's height and rate at t = 0 and h
   double hq_[4] = {0.0, 0.0, 0.0, 0.0};  // the corrected model's miss grows by this per unit t (predicted_miss)  // the full step's angular velocity after its support solve
   // A curved die whose touching rims the support solve does not push (their material points leave

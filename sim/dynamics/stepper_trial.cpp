@@ -13,6 +13,46 @@ namespace dicesim {
 
 using stepper_detail::mechanical_energy;
 
+namespace {
+
+// Leapfrog: the velocity (m/s, world) at which the solve at the step's middle holds c's corners
+// (its bias). A corner moves with the free rotation except for the solve: acceleration a = w x
+// (w x r) + dw/dt x r, dw/dt = -I_w^-1 (w x L), taken at the middle before the solve. Held at B
+// there, it ends the step a half^2 + B half from where it started, moving at B + a half: B = -a
+// half returns it to its start, at rest, to first order. The whole vector, not only its normal
+// part: on a die rocking about a held edge, a is the pivot's centripetal acceleration, along the
+// line to the COM. With B = 0 the pivot ended every step a half^2 above the floor and ahead of
+// where it was: it left the contact set, fell and landed again plastically, losing energy, a loss
+// that moved with the tolerance. Holding only the normal part put the centripetal impulse off the
+// line through the COM, a torque that changed the spin by O(h) (the landing speed 0.2-0.5 % low).
+// The normal part also corrects the corner's start height z and normal velocity v: above the
+// floor - z / d - v / 2, which takes (z, v d) to (0, 0) in two steps without oscillation
+// (eigenvalues 0, 0; closing the middle's gap alone reflects v every step, a period-2 oscillation
+// that never decays); below it - k v / 2 only (k = d / span; try_step adds the depth's own term,
+// the shallowest corner's over the ceiling's length). The solve shifts every corner alike: the
+// normal part is the most any corner asks, the tangential part that corner's. (The spin the solve
+// makes is not in a: predicted from the last step's impulses it sank held corners 50 um, after a
+// sub-threshold landing whose impulse was no force.)
+Vec3 leapfrog_bias(const DieModel& m, const RigidState& s0, const ContactSet& c, const Mat3& R_mid, const Vec3& w,
+                   double d, double k) {
+  const double half = 0.5 * d;
+  const Vec3 wb = R_mid.transpose() * w;
+  const Vec3 alpha = R_mid * (-(wb.cross(Vec3(m.principal_moments.cwiseProduct(wb)))).cwiseQuotient(m.principal_moments));
+  Vec3 B(0.0, 0.0, -std::numeric_limits<double>::infinity());
+  for (int i = 0; i < c.n; ++i) {
+    const Vec3 r = contact_point(m, R_mid, c.vertex[i]);
+    const Vec3 r0 = contact_point(m, s0.R, c.vertex[i]);
+    const double z = s0.position.z() + r0.z();
+    const double v = (s0.velocity + s0.omega.cross(r0)).z();
+    const Vec3 a = w.cross(w.cross(r)) + alpha.cross(r);
+    const double bn = z > 0.0 ? -a.z() * half - z / d - 0.5 * v : -a.z() * half - 0.5 * k * v;
+    if (bn > B.z()) B = Vec3(-a.x() * half, -a.y() * half, bn);
+  }
+  return B;
+}
+
+}  // namespace
+
 void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full) {
   const DieModel& m = *m_;
   // `impulse` (hold_): a flat die's held corners are asked to end the step on the floor, v_n >= b
@@ -28,6 +68,7 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   // nearly under the COM). Checked at the step's end: if it gains, b / 4, then none: the plain
   // step, which never gains kinetic + m g z (counted, rise_dropped; its corners' depth stays).
   if (full) full_bias_ = 0.0;
+  slip_bias_ = Eigen::Vector2d::Zero();
   if (!hold_ || m.curved() || c.n == 0) {
     try_step_with(s0, c, d, a, full, 0.0);
     return;
@@ -35,7 +76,21 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   // Adaptive steps: the depth is taken out over the ceiling's length at least (a short step asked
   // to close it alone would rise fast, and gain energy).
   const double span = adaptive_.tol > 0.0 ? std::max(d, h_max_) : d;
-  const double b = std::min(start_shallow_ / span + 0.5 * a_down_ * d, m.gravity * d);
+  double b = std::min(start_shallow_ / span + 0.5 * a_down_ * d, m.gravity * d);
+  if (leapfrog() && d > 0.0) {
+    // (What the held corners ask at the step's middle: leapfrog_bias.)
+    Mat3 R_mid;
+    Vec3 w_mid;
+    start_rot_->state(0.5 * d, R_mid, w_mid);
+    const Vec3 B = leapfrog_bias(m, s0, c, R_mid, w_mid, d, d / span);
+    slip_bias_ = B.head<2>();
+    b = std::min(start_shallow_ / span + B.z(), m.gravity * d);
+    if (!(b > 0.0)) {
+      try_step_with(s0, c, d, a, full, b);
+      if (full) full_bias_ = b;
+      return;
+    }
+  }
   if (try_step_with(s0, c, d, a, full, b)) {
     if (full) full_bias_ = b;
     return;
@@ -69,7 +124,7 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   return a.held_e <= e_start_ + m_->mass * m_->gravity * start_depth_max_ + split_gain(d);
 }
 
-void FixedStepper::try_step_fixed(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full,
+void FixedStepper::try_step_fixed(const RigidState& /*s0: a.s already holds it*/, const ContactSet& c, double d, Attempt& a, bool full,
                                   double bias) {
   const DieModel& m = *m_;
   RigidState& s = a.s;
@@ -141,8 +196,10 @@ void FixedStepper::try_step_dkd(const RigidState& s0, const ContactSet& c, doubl
     s.position = s0.position + half * s0.velocity;
     s.velocity.z() -= kick_g_ * d;
     s.velocity.z() -= bias;
+    s.velocity.head<2>() -= slip_bias_;
     a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next);
     s.velocity.z() += bias;
+    s.velocity.head<2>() += slip_bias_;
     const Vec3 L = world_inertia(m, s.R) * s.omega;  // the solve's angular momentum, kept by the second half
     if (full) {
       full_p_ = s0.position;
