@@ -82,7 +82,8 @@ TEST(CliFirstHour, ASweepPointThatFailsIsNamed) {
 TEST(CliFirstHour, TossHelpSaysWhichFidelity) {
   const std::string help = cli("toss --help").out;
   for (const char* f : {"Which fidelity", "auto     the cheapest model measured adequate", "impulse  a real, unfair die",
-                        "stepped  the reference", "paper    only to reproduce", "static   a die placed"})
+                        "stepped  the reference", "paper    only to reproduce", "static   a die placed",
+                        "sim.contact_tol (leapfrog steps) is experimental: leave it 0"})
     EXPECT_NE(help.find(f), std::string::npos) << f << "\n" << help;
 }
 
