@@ -78,27 +78,26 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   const double span = adaptive_.tol > 0.0 ? std::max(d, h_max_) : d;
   double b = std::min(start_shallow_ / span + 0.5 * a_down_ * d, m.gravity * d);
   if (leapfrog() && d > 0.0) {
-    // (What the held corners ask at the step's middle: leapfrog_bias.)
+    // The leapfrog's solve is at the step's middle: what the held corners ask there, a vector
+    // (leapfrog_bias), replaces a_down_'s term; negative where the pivot's acceleration lifts it.
     Mat3 R_mid;
     Vec3 w_mid;
     start_rot_->state(0.5 * d, R_mid, w_mid);
     const Vec3 B = leapfrog_bias(m, s0, c, R_mid, w_mid, d, d / span);
     slip_bias_ = B.head<2>();
     b = std::min(start_shallow_ / span + B.z(), m.gravity * d);
-    if (!(b > 0.0)) {
-      try_step_with(s0, c, d, a, full, b);
-      if (full) full_bias_ = b;
-      return;
-    }
   }
+  // (The leapfrog's whole bias, normal and tangential, is checked and scaled down alike.)
   if (try_step_with(s0, c, d, a, full, b)) {
     if (full) full_bias_ = b;
     return;
   }
+  slip_bias_ *= 0.25;
   if (try_step_with(s0, c, d, a, full, 0.25 * b)) {
     if (full) full_bias_ = 0.25 * b;
     return;
   }
+  slip_bias_.setZero();
   try_step_with(s0, c, d, a, full, 0.0);
   a.rise_dropped = true;
 }
@@ -111,14 +110,14 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   if (impact_) a.imp = imp_;
   a.next.n = 0;
   a.capped = a.clamped = a.unreflected = false;
-  a.risen = bias > 0.0;
+  a.risen = bias != 0.0 || !slip_bias_.isZero();  // (fixed steps: bias >= 0, no slip)
   a.rise_dropped = false;
   if (leapfrog()) {
     try_step_dkd(s0, c, d, a, full, bias);
   } else {
     try_step_fixed(s0, c, d, a, full, bias);
   }
-  if (!(bias > 0.0)) return true;
+  if (!a.risen) return true;
   // (New corners below the floor are the located step's business.)
   a.held_e = held_energy(a.s, c);
   return a.held_e <= e_start_ + m_->mass * m_->gravity * start_depth_max_ + split_gain(d);
