@@ -107,9 +107,9 @@ TEST(SustainedChecks, DISABLED_RockingDieAtTheDefaultStep) {
 //   1e-3    +0.0015 %      +0.044 %          +0.040 %   +0.074 %
 //   3e-4    +0.0015 %      +0.016 %          +0.072 %   -0.0084 %
 //   1e-4    +0.0015 %      -0.0038 %         +0.034 %   -0.0066 %
-//   3e-5    +0.0015 %      -0.024 %          +0.0002 %  +0.0049 %
-//   1e-5    +0.0015 %      -0.0061 %         +0.0019 %  +0.0010 %
-//   1e-6    +0.0015 %      -0.0043 %         -0.0035 %  -0.0045 %
+//   3e-5    +0.0015 %      -0.011 %          +0.0010 %  +0.0049 %
+//   1e-5    +0.0015 %      +0.0010 %         +0.0008 %  +0.0009 %
+//   1e-6    +0.0015 %      -0.0022 %         -0.0019 %  +0.0012 %
 // Fixed 3 ms steps: -0.88 % and -2.7 % (the DISABLED_ tests above). Before the bias held the
 // pivot's whole acceleration (normal part only, or none) the rocking die read 0.5-1.5 % low at
 // some tolerances: its pivot left the floor every few steps and landed again plastically.

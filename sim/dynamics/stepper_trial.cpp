@@ -26,10 +26,12 @@ namespace {
 // that moved with the tolerance. Holding only the normal part put the centripetal impulse off the
 // line through the COM, a torque that changed the spin by O(h) (the landing speed 0.2-0.5 % low).
 // The normal part also corrects the corner's start height z and normal velocity v: above the
-// floor - z / d - v / 2, which takes (z, v d) to (0, 0) in two steps without oscillation
-// (eigenvalues 0, 0; closing the middle's gap alone reflects v every step, a period-2 oscillation
-// that never decays); below it - k v / 2 only (k = d / span; try_step adds the depth's own term,
-// the shallowest corner's over the ceiling's length). The solve shifts every corner alike: the
+// floor - k (z / d + v / 2), which takes (z, v d) to (z (1 - k / 2) + v d (1 - k / 2) / 2, -k z -
+// k v d / 2), eigenvalues 0 and 1 - k: back to the floor without oscillation (closing the
+// middle's gap alone reflects v every step, a period-2 oscillation that never decays); below it
+// - k v / 2 only (try_step adds the depth's own term, the shallowest corner's). k = d / span: over
+// the ceiling's length, as the depth (with k = 1 the bias varied as 1 / d across a located step's
+// trials, and a Die 1 toss took 2.56 trials per located step instead of 2.29). The solve shifts every corner alike: the
 // normal part is the most any corner asks, the tangential part that corner's. (The spin the solve
 // makes is not in a: predicted from the last step's impulses it sank held corners 50 um, after a
 // sub-threshold landing whose impulse was no force.)
@@ -45,7 +47,7 @@ Vec3 leapfrog_bias(const DieModel& m, const RigidState& s0, const ContactSet& c,
     const double z = s0.position.z() + r0.z();
     const double v = (s0.velocity + s0.omega.cross(r0)).z();
     const Vec3 a = w.cross(w.cross(r)) + alpha.cross(r);
-    const double bn = z > 0.0 ? -a.z() * half - z / d - 0.5 * v : -a.z() * half - 0.5 * k * v;
+    const double bn = z > 0.0 ? -a.z() * half - k * (z / d + 0.5 * v) : -a.z() * half - 0.5 * k * v;
     if (bn > B.z()) B = Vec3(-a.x() * half, -a.y() * half, bn);
   }
   return B;
