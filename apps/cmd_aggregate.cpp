@@ -16,6 +16,7 @@
 #include "aggregator/session.hpp"
 #include "aggregator/target.hpp"
 #include "apps/commands.hpp"
+#include "apps/interrupt.hpp"
 #include "sim/scene/scene_hash.hpp"
 #include "apps/fidelity_name.hpp"
 #include "apps/progress.hpp"
@@ -30,9 +31,6 @@
 
 namespace dicesim {
 namespace {
-
-std::atomic<bool> g_stop{false};
-void on_stop_signal(int) { g_stop = true; }
 
 // With a target and no explicit --tosses, the run may go this far.
 constexpr std::uint64_t kTargetCap = 1'000'000'000;

@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include "apps/commands.hpp"
+#include "apps/interrupt.hpp"
 #include "bridge/bridge.hpp"
 #include "bridge/dds_config.hpp"
 #include "logger/log.hpp"
@@ -14,9 +15,6 @@
 
 namespace dicesim {
 namespace {
-
-std::atomic<bool> g_stop{false};
-void on_stop_signal(int) { g_stop = true; }
 
 struct BridgeArgs {
   std::string lcm;

@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include "apps/commands.hpp"
+#include "apps/interrupt.hpp"
 #include "logger/event_log.hpp"
 #include "logger/log.hpp"
 #include "logger/record.hpp"
@@ -12,9 +13,6 @@
 
 namespace dicesim {
 namespace {
-
-std::atomic<bool> g_stop{false};
-void on_stop_signal(int) { g_stop = true; }
 
 struct RecordArgs {
   std::string lcm;

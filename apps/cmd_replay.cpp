@@ -11,6 +11,7 @@
 
 #include "aggregator/session.hpp"
 #include "apps/commands.hpp"
+#include "apps/interrupt.hpp"
 #include "apps/report.hpp"
 #include "messages/spec_scene.hpp"
 #include "logger/event_log.hpp"
@@ -19,9 +20,6 @@
 
 namespace dicesim {
 namespace {
-
-std::atomic<bool> g_stop{false};
-void on_stop_signal(int) { g_stop = true; }
 
 struct ReplayArgs {
   std::string path;

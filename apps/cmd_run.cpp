@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "apps/commands.hpp"
+#include "apps/interrupt.hpp"
 #include "apps/lcm_hub.hpp"
 #include "apps/worker_processes.hpp"
 #include "messages/run_spec.hpp"
@@ -15,9 +16,6 @@
 
 namespace dicesim {
 namespace {
-
-std::atomic<bool> g_stop{false};
-void on_stop_signal(int) { g_stop = true; }
 
 struct RunArgs {
   AggregateArgs agg;

@@ -11,6 +11,7 @@
 
 #include "messages/lcm_wait.hpp"
 #include "apps/commands.hpp"
+#include "apps/interrupt.hpp"
 #include "apps/info_json.hpp"
 #include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
@@ -25,9 +26,6 @@
 
 namespace dicesim {
 namespace {
-
-std::atomic<bool> g_stop{false};
-void on_stop_signal(int) { g_stop = true; }
 
 struct ServeArgs {
   std::string lcm;

@@ -10,14 +10,12 @@
 
 #include "messages/lcm_wait.hpp"
 #include "apps/commands.hpp"
+#include "apps/interrupt.hpp"
 #include "messages/auth.hpp"
 #include "messages/wire.hpp"
 
 namespace dicesim {
 namespace {
-
-std::atomic<bool> g_stop{false};
-void on_stop_signal(int) { g_stop = true; }
 
 struct WatchArgs {
   std::string lcm;

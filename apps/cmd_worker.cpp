@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include "apps/commands.hpp"
+#include "apps/interrupt.hpp"
 #include "logger/log.hpp"
 #include "messages/run_spec.hpp"
 #include "messages/wire.hpp"
@@ -14,9 +15,6 @@
 
 namespace dicesim {
 namespace {
-
-std::atomic<bool> g_stop{false};
-void on_stop_signal(int) { g_stop = true; }
 
 struct WorkerArgs {
   std::string lcm;

@@ -33,4 +33,7 @@ InterruptGuard::~InterruptGuard() {
 
 const std::atomic<bool>* InterruptGuard::flag() { return &g_interrupted; }
 
+std::atomic<bool> g_stop{false};
+void on_stop_signal(int) { g_stop = true; }
+
 }  // namespace dicesim

@@ -21,4 +21,11 @@ class InterruptGuard {
   static bool interrupted() { return flag()->load(); }
 };
 
+// The bus commands (aggregate, bridge, record, replay, run, serve, watch, worker) run until
+// stopped instead: they install on_stop_signal for SIGINT and SIGTERM and poll g_stop. One flag
+// for all of them (a process runs one command), defined once, so that apps/ builds as one unity
+// file too (apps/CMakeLists.txt).
+extern std::atomic<bool> g_stop;
+void on_stop_signal(int);
+
 }  // namespace dicesim

@@ -12,9 +12,9 @@
 #include "sim/dynamics/contact.hpp"
 
 namespace dicesim {
-
-using namespace friction_detail;
-
+// friction_detail's names are brought in per function, never for the whole namespace: its Body
+// would otherwise clash with dicesim::Body in a unity build (sim/CMakeLists.txt).
+namespace friction_detail {
 namespace {
 
 // Whether every point's tangential slip is at least mu times its approach speed (|u_t| >= mu |u_n|),
@@ -29,9 +29,12 @@ bool slips_past_cone(const Body& b, const Points& pts) {
 }
 
 }  // namespace
+}  // namespace friction_detail
 
 ImpactResult apply_friction_impact_at(const DieModel& m, RigidState& s, const ContactSet& c, const Vec3* r,
                                       bool restitution) {
+  using namespace friction_detail;
+  using friction_detail::Body;
   // (Body's own initialisation from the product, as apply_friction_impact's set-up has it.)
   const Body b0{m.mass, 1.0 / m.mass, s.R * m.principal_moments.cwiseInverse().asDiagonal() * s.R.transpose(), &s};
   ContactGeometry geo;
@@ -42,6 +45,9 @@ ImpactResult apply_friction_impact_at(const DieModel& m, RigidState& s, const Co
 ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,
                                    const ContactImpulses* warm, ContactImpulses* out, ContactGeometry* geometry,
                                    bool direct) {
+  using namespace friction_detail;
+  using friction_detail::Body;
+  using friction_detail::SweepResult;
   ImpactResult res;
   if (out) out->n = 0;
   if (c.n == 0) return res;

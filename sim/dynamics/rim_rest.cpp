@@ -10,8 +10,6 @@
 namespace dicesim {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 // Distance from the COM (origin) to the nearest point of the circle centre c, axis k, radius a.
 double circle_distance(const Vec3& c, const Vec3& k, double a) {
   const Vec3 w = -c;
@@ -121,7 +119,7 @@ int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, 
 }
 
 double rim_lowest_excluding(const DieModel& m, const Mat3& R, const ContactSet& c) {
-  double low = kInf;
+  double low = std::numeric_limits<double>::infinity();
   const RimFeatures rims(m, R);
   int j = 0;  // c.vertex is ascending
   for (int i = 0; i < kRimFeatures; ++i) {

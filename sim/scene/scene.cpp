@@ -25,7 +25,6 @@ namespace dicesim {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kInf = std::numeric_limits<double>::infinity();
 // The source name of every value that came from an override: the scene it overrides, marked.
 std::string set_origin(const std::string& scene) { return scene + " (--set)"; }
 
@@ -103,6 +102,7 @@ std::string num_text(double v) {
 
 // The closed or open interval a number must lie in, and its unit, as the message shows it.
 struct Range {
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
   double lo = -kInf, hi = kInf;
   bool lo_open = false, hi_open = false;
   const char* unit = "";

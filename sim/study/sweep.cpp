@@ -27,7 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 constexpr std::size_t kMaxValues = 100000;
 
-std::string trim(std::string_view s) {
+std::string trim_space(std::string_view s) {
   const auto b = s.find_first_not_of(" \t\r\n");
   const auto e = s.find_last_not_of(" \t\r\n");
   return b == std::string_view::npos ? "" : std::string(s.substr(b, e - b + 1));
@@ -35,11 +35,11 @@ std::string trim(std::string_view s) {
 
 // A finite number or a fraction p/q; nullopt otherwise.
 std::optional<double> parse_number(std::string_view text) {
-  const std::string t = trim(text);
+  const std::string t = trim_space(text);
   if (t.empty()) return std::nullopt;
   const auto slash = t.find('/');
   auto one = [](std::string_view s) -> std::optional<double> {
-    const std::string u = trim(s);
+    const std::string u = trim_space(s);
     if (u.empty()) return std::nullopt;
     double v = 0.0;
     const char* b = u.data();
@@ -164,7 +164,7 @@ std::string short_text(double v) {
 std::vector<double> parse_values(const std::string& spec, const std::string& origin, const std::string& key) {
   const std::string form = "expected start:stop:step (e.g. 0.4:4.2:0.2) or a list a,b,c; numbers may be fractions p/q";
   auto bad = [&](const std::string& why) { return SceneError(origin, key, "'" + spec + "'", why); };
-  const std::string s = trim(spec);
+  const std::string s = trim_space(spec);
   if (s.empty()) throw bad("is empty: " + form);
   std::vector<double> out;
   if (s.find(':') != std::string::npos) {
@@ -176,7 +176,7 @@ std::vector<double> parse_values(const std::string& spec, const std::string& ori
     std::array<double, 3> v{};
     for (int i = 0; i < 3; ++i) {
       const auto n = parse_number(parts[static_cast<std::size_t>(i)]);
-      if (!n) throw bad("'" + trim(parts[static_cast<std::size_t>(i)]) + "' is not a finite number: " + form);
+      if (!n) throw bad("'" + trim_space(parts[static_cast<std::size_t>(i)]) + "' is not a finite number: " + form);
       v[static_cast<std::size_t>(i)] = *n;
     }
     const double a = v[0], b = v[1], step = v[2];
@@ -200,7 +200,7 @@ std::vector<double> parse_values(const std::string& spec, const std::string& ori
       const std::size_t c = s.find(',', start);
       const std::string item = s.substr(start, c == std::string::npos ? std::string::npos : c - start);
       const auto n = parse_number(item);
-      if (!n) throw bad("'" + trim(item) + "' is not a finite number: " + form);
+      if (!n) throw bad("'" + trim_space(item) + "' is not a finite number: " + form);
       out.push_back(*n);
       if (out.size() > kMaxValues) throw bad("more than " + std::to_string(kMaxValues) + " values");
       if (c == std::string::npos) break;
@@ -443,7 +443,7 @@ std::vector<ReferenceRow> load_reference_table(const std::string& path) {
   int line_no = 0;
   while (std::getline(in, line)) {
     ++line_no;
-    const std::string t = trim(line);
+    const std::string t = trim_space(line);
     if (t.empty() || t[0] == '#') continue;
     if (!header) {
       header = true;
