@@ -148,8 +148,9 @@ struct FloorDef {
 
 // `impulse`'s default contact step. A polyhedron's sustained contact is mostly events (each new
 // corner's touch located exactly; its held corners kept on the floor, and the step shortened
-// where the die's spin would sink them: contact_stepper.hpp), and Dice 1-3 and the fair die agree
-// with `stepped` at 0.1 and 0.05 ms at 3 ms (docs/fidelity.md, "Held corners kept on the floor").
+// where the die's spin would sink them: contact_stepper.hpp), and at 3 ms its faces are where a
+// 10x finer step puts them on Dice 1-3, the fair die and the d20 (docs/fidelity.md, "Convergence
+// as equivalence tests").
 // A cylinder's rim rolls continuously and its edge rate moves with the step (docs/fidelity.md,
 // the quarter's edge rate): it keeps 1 ms.
 inline constexpr double kContactStepPolyhedron = 3e-3;
