@@ -363,6 +363,11 @@ class FixedStepper {
   // Leapfrog: the held corners' tangential velocity at the step's middle (leapfrog_bias, the
   // tangential part of the bias; try_step sets it for try_step_dkd's solve).
   Eigen::Vector2d slip_bias_ = Eigen::Vector2d::Zero();
+  // Leapfrog: start_rot_'s state at mid_d_ / 2 (the bias's, try_step), reused by try_step_dkd's
+  // first half drift of the same trial; mid_d_ < 0: none.
+  Mat3 mid_R_ = Mat3::Identity();
+  Vec3 mid_w_ = Vec3::Zero();
+  double mid_d_ = -1.0;
   bool hermite_ = false;  // hq_ holds the arriving corner's height and rate at t = 0 and h
   double hq_[4] = {0.0, 0.0, 0.0, 0.0};  // the corrected model's miss grows by this per unit t (predicted_miss)  // the full step's angular velocity after its support solve
   // A curved die whose touching rims the support solve does not push (their material points leave

@@ -71,6 +71,7 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   // step, which never gains kinetic + m g z (counted, rise_dropped; its corners' depth stays).
   if (full) full_bias_ = 0.0;
   slip_bias_ = Eigen::Vector2d::Zero();
+  mid_d_ = -1.0;
   if (!hold_ || m.curved() || c.n == 0) {
     try_step_with(s0, c, d, a, full, 0.0);
     return;
@@ -78,16 +79,17 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   // Adaptive steps: the depth is taken out over the ceiling's length at least (a short step asked
   // to close it alone would rise fast, and gain energy).
   const double span = adaptive_.tol > 0.0 ? std::max(d, h_max_) : d;
-  double b = std::min(start_shallow_ / span + 0.5 * a_down_ * d, m.gravity * d);
+  double b;
   if (leapfrog() && d > 0.0) {
     // The leapfrog's solve is at the step's middle: what the held corners ask there, a vector
     // (leapfrog_bias), replaces a_down_'s term; negative where the pivot's acceleration lifts it.
-    Mat3 R_mid;
-    Vec3 w_mid;
-    start_rot_->state(0.5 * d, R_mid, w_mid);
-    const Vec3 B = leapfrog_bias(m, s0, c, R_mid, w_mid, d, d / span);
+    start_rot_->state(0.5 * d, mid_R_, mid_w_);
+    mid_d_ = d;
+    const Vec3 B = leapfrog_bias(m, s0, c, mid_R_, mid_w_, d, d / span);
     slip_bias_ = B.head<2>();
     b = std::min(start_shallow_ / span + B.z(), m.gravity * d);
+  } else {
+    b = std::min(start_shallow_ / span + 0.5 * a_down_ * d, m.gravity * d);
   }
   // (The leapfrog's whole bias, normal and tangential, is checked and scaled down alike.)
   if (try_step_with(s0, c, d, a, full, b)) {
@@ -193,7 +195,12 @@ void FixedStepper::try_step_dkd(const RigidState& s0, const ContactSet& c, doubl
       slot = start_rot_;  // the model's free motion is this motion
     }
   } else {
-    start_rot_->state(half, s.R, s.omega);
+    if (mid_d_ == d) {  // try_step's evaluation for the bias, of the same trial
+      s.R = mid_R_;
+      s.omega = mid_w_;
+    } else {
+      start_rot_->state(half, s.R, s.omega);
+    }
     s.position = s0.position + half * s0.velocity;
     s.velocity.z() -= kick_g_ * d;
     s.velocity.z() -= bias;
