@@ -174,8 +174,8 @@ void register_toss(CLI::App& app, int& exit_code) {
       "  auto     the cheapest model measured adequate for this scene at this run's precision, else\n"
       "           impulse (`dicesim info SCENE` says which and why)\n"
       "  impulse  a real, unfair die or coin: friction, rolling, tipping to rest; its accuracy knob is\n"
-      "           sim.contact_step (default 3 ms for polyhedra, 1 ms for cylinders; a coin's edge rate\n"
-      "           needs <= 0.2 ms). sim.contact_tol (leapfrog steps) is experimental: leave it 0\n"
+      "           sim.contact_step (default 3 ms for polyhedra, 0.2 ms for cylinders, each measured\n"
+      "           converged). sim.contact_tol (leapfrog steps) is experimental: leave it 0\n"
       "  stepped  the reference (fixed 0.2 ms steps), ~6x slower than impulse: to check a new die\n"
       "  paper    only to reproduce the seed's tables (frictionless corners, a rebound-speed stop)\n"
       "  static   a die placed, not thrown (random orientation, quasi-static roll); instant");

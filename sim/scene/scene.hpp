@@ -151,20 +151,20 @@ struct FloorDef {
 // where the die's spin would sink them: contact_stepper.hpp), and at 3 ms its faces are where a
 // 10x finer step puts them on Dice 1-3, the fair die and the d20 (docs/fidelity.md, "Convergence
 // as equivalence tests").
-// A cylinder's rim rolls continuously and its edge rate moves with the step (docs/fidelity.md,
-// the quarter's edge rate): it keeps 1 ms.
+// A cylinder's rim rolls continuously, first order in the step: 0.2 ms is the longest step
+// measured equivalent to `stepped` at 0.1 ms on the quarter's edge rate (|d edge| < 0.2 p_edge,
+// 10^5 tosses; 0.5 ms was not) and it holds Euler's disk's precession within 0.3 % (1 ms: -1.2 %)
+// (docs/fidelity.md, "Coins").
 inline constexpr double kContactStepPolyhedron = 3e-3;
-inline constexpr double kContactStepCurved = 1e-3;
+inline constexpr double kContactStepCurved = 2e-4;
 // sim.contact_tol > 0: a polyhedron's sustained contact in `impulse` is leapfrog with an
 // error-controlled step (contact_stepper.hpp, AdaptiveSteps): the tolerance bounds each step's
 // estimated position error of any body point, relative to the die's bounding radius; the contact
 // step above is then the ceiling, kContactStepFloor the floor (located steps, which end at a new
 // contact's instant, may be shorter). 0 (the default): fixed first-order steps of the contact step.
-// Experimental, not the default: a rocking die's landing does not converge monotonically with the
-// tolerance (0.5-1.5 % low at some), its energy bound is m (g h)^2 / 8 a step rather than rounding,
-// and on Die 1 it leaves the face distribution where fixed 3 ms steps put it (2*10^4 tosses: at
-// most 26 outcomes differ) at 2.4-2.9x the cost (docs/fidelity.md, "Sustained contact"). Curved
-// dice ignore it.
+// Experimental, not the default: on five dice at 3*10^5 tosses it leaves the faces where fixed
+// 3 ms steps put them, at 2.5-2.7x the cost, and its energy bound is m (g h)^2 / 8 a step rather
+// than rounding (docs/fidelity.md, "Leapfrog steps"). Curved dice ignore it.
 inline constexpr double kContactTolDefault = 0.0;
 inline constexpr double kContactStepFloor = 1e-4;
 
