@@ -153,7 +153,9 @@ serve_trace_scenario() {
   [ "$code" = 404 ] && grep -q 'id="trace-error"' "$work/unknown.html" || fail "an unknown run's trace is $code, not 404 with a reason"
   "$bin" show $scene --fidelity impulse --seed $seed --tosses $tosses --toss $index -o "$work/show.html" 2> "$work/show.err" ||
     { cat "$work/show.err" >&2; fail "show exited $?"; }
-  BROWSE_S=${BROWSE_S:-8} browse_live serve-trace "http://127.0.0.1:$port/"
+  # Under load the page may start playing late: wait (up to 30 s more) for its clock to leave 0.
+  CDP_UNTIL="parseFloat(((document.getElementById('trace-clock') || {}).textContent || '').replace(/^.*t = /, '')) > 0" \
+    BROWSE_S=${BROWSE_S:-8} browse_live serve-trace "http://127.0.0.1:$port/"
   /usr/bin/python3 - "$work" "$index" "$every" <<'PY' || fail "the served page does not animate show's toss $index"
 import json, re, sys
 from PIL import Image

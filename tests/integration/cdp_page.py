@@ -7,6 +7,8 @@ needs nothing but the standard library. Console errors and uncaught exceptions (
 its frames) are written to ERRORS, one a line.
 
     cdp_page.py URL SECONDS DOM.html SHOT.png ERRORS.txt [WIDTHxHEIGHT]
+
+Environment: CDP_UNTIL, a JavaScript condition to wait for after SECONDS (CDP_UNTIL_MAX s at most).
 """
 import base64
 import json
@@ -105,6 +107,15 @@ try:
          session=session)
     call("Page.navigate", {"url": url}, session=session)
     pump(seconds)
+    # CDP_UNTIL (a JavaScript expression): then keep the page running, up to CDP_UNTIL_MAX more
+    # seconds (default 30), until it is true. A loaded machine can leave swiftshader's WebGL page
+    # not yet animating after SECONDS (the test's own assertion still decides).
+    until, waited = os.environ.get("CDP_UNTIL"), 0.0
+    while until and waited < float(os.environ.get("CDP_UNTIL_MAX", "30")):
+        if call("Runtime.evaluate", {"expression": f"!!({until})", "returnByValue": True}, session=session)["result"].get("value"):
+            break
+        pump(0.5)
+        waited += 0.5
     dom = call("Runtime.evaluate", {"expression": "document.documentElement.outerHTML", "returnByValue": True},
                session=session)["result"]["value"]
     open(dom_path, "w").write(dom)
