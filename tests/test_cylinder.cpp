@@ -30,12 +30,17 @@ using namespace dicesim;
 
 namespace {
 
-// A ready coin scene. Its `impulse` toss indices below were found at the cylinder's contact step
-// before it became 0.2 ms (1 ms; quarter-table.toml's own 0.5 ms), so they keep that step: each
-// still exercises the case it was found for. Overrides given here come after it and win.
+// A ready coin scene as it ships (its default contact step).
+SceneDef ready_coin(const std::string& file, const std::vector<std::string>& overrides = {}) {
+  return load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/" + file, overrides);
+}
+
+// The same for the tests that replay particular `impulse` toss indices: those were found at the
+// cylinder's contact step before it became 0.2 ms (1 ms; quarter-table.toml's own 0.5 ms), so they
+// keep that step, and each still exercises the case it was found for. Overrides given here win.
 SceneDef load_coin(const std::string& file, std::vector<std::string> overrides = {}) {
   overrides.insert(overrides.begin(), file == "quarter-table.toml" ? "sim.contact_step=5e-4" : "sim.contact_step=1e-3");
-  return load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/" + file, overrides);
+  return ready_coin(file, overrides);
 }
 
 // A homogeneous coin scene (TOML), radius a, height h (m), extra lines appended.
@@ -442,7 +447,7 @@ TEST(CylinderImpulse, PivotingResistanceOpposesOnlyTheSpinOnOnePoint) {
 // of the floor; what the steps leave deeper is lifted and counted (overlap_fixes: the slapping
 // rim, rim_support in contact_stepper.cpp, about 2.5 a toss, an open item).
 TEST(CylinderImpulse, QuarterRimsStayOnTheFloorWithConvergedSolves) {
-  const DieModel m = compile(load_coin("quarter-table.toml"));
+  const DieModel m = compile(ready_coin("quarter-table.toml"));
   const int n = 200;
   std::uint64_t unconverged = 0, fixes = 0;
   for (int i = 0; i < n; ++i) {
@@ -468,7 +473,7 @@ TEST(CylinderImpulse, QuarterRimsStayOnTheFloorWithConvergedSolves) {
 // the rims stay on the floor with no lift and no step gains mechanical energy (lifted 40 times in
 // these 400 steps before the curvature impulse).
 TEST(CylinderImpulse, SlappingQuarterNeedsNoLift) {
-  const DieModel m = compile(load_coin("quarter-table.toml"));
+  const DieModel m = compile(ready_coin("quarter-table.toml"));
   for (const double tilt_deg : {5.0, 8.0, 12.0}) {
     RigidState s;
     const double tilt = tilt_deg * kPi / 180.0;
@@ -519,7 +524,7 @@ TEST(CylinderImpulse, SlappingFaceIsLocatedNotLifted) {
 // rim at the pass). Each lifted once or twice on ca346f7's stepper; the face's arrival is now an
 // impact. (Its capped near-half curvature impulses still count energy clamps: docs/fidelity.md.)
 TEST(CylinderImpulse, SlappingFaceIsStruck) {
-  const DieModel m = compile(load_coin("quarter.toml"));
+  const DieModel m = compile(ready_coin("quarter.toml"));
   for (const double tilt : {3e-3, 1e-3}) {
     for (const double miss : {0.003, 0.03, 0.1}) {
       RigidState s;
@@ -765,13 +770,13 @@ TEST(CylinderImpulse, ShortStepStartingBelowTheFloorHoldsItsDepth) {
 // spin slows the rocking grows until it leaves the band (+-3.2 deg of upright, where the COM is
 // above the side) and falls flat, like a real spun coin. Steps of 0.1 ms show it from these states
 // (tilt 1.3 deg, 25 and 40 rad/s); 1 ms steps damped the growth and left the coin standing (edge).
-// The scene's contact step (5e-4) must agree with the fine one. No step may gain held energy: with
+// The default contact step (0.2 ms) must agree with the fine one. No step may gain held energy: with
 // nothing to slow the spin (a point contact has no torsional friction) the stepper's first-order
 // error raised it at the rock's turning points, 94 and 101 energy clamps in these two states (kind
 // A of issue 13); the rim's pivoting resistance (rim_rest.hpp, the default 3e-6 m) dissipates more
 // than that error, and the coin falls sooner (7.5 -> 5.2 s and 11.2 -> 8.2 s).
 TEST(CylinderImpulse, UprightSpinningQuarterFallsAsItSlows) {
-  const DieModel m = compile(load_coin("quarter-table.toml"));
+  const DieModel m = compile(ready_coin("quarter-table.toml"));
   for (const double w : {25.0, 40.0}) {
     RigidState s;
     const double tilt = 1.3 * kPi / 180.0;
@@ -919,7 +924,7 @@ TEST(CylinderStepped, FlatCoinsSpinOverStrikesTheRimBetweenTheTripod) {
 // tripod the lowest pair, so a coin landing flat was not seen as a face (three-sided coin
 // `stepped`, seed 1, toss 96416: a kind B clamp on e802e6a). The lowest feature is the lowest.
 TEST(CylinderImpulse, NearlyFlatLowestFeatureIsTheLowestWhenTheAxisRoundsAboveOne) {
-  const DieModel m = compile(load_coin("three-sided-coin.toml"));
+  const DieModel m = compile(ready_coin("three-sided-coin.toml"));
   for (const double tilt : {1e-9, 3e-8, 1e-7}) {
     const Vec3 n(-std::sin(tilt), 0.3 * std::sin(tilt), std::cos(tilt));
     Mat3 R = Quat::FromTwoVectors(m.rims.axis, n.normalized()).toRotationMatrix();

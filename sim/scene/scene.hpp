@@ -151,10 +151,10 @@ struct FloorDef {
 // where the die's spin would sink them: contact_stepper.hpp), and at 3 ms its faces are where a
 // 10x finer step puts them on Dice 1-3, the fair die and the d20 (docs/fidelity.md, "Convergence
 // as equivalence tests").
-// A cylinder's rim rolls continuously, first order in the step: 0.2 ms is the longest step
-// measured equivalent to `stepped` at 0.1 ms on the quarter's edge rate (|d edge| < 0.2 p_edge,
-// 10^5 tosses; 0.5 ms was not) and it holds Euler's disk's precession within 0.3 % (1 ms: -1.2 %)
-// (docs/fidelity.md, "Coins").
+// A cylinder's rim rolls continuously, first order in the step: 0.2 ms holds Euler's disk within
+// 0.3 % and the quarter on a table's edge rate within 0.2 p_edge of `stepped` (10^5 tosses; 0.5 ms
+// not), but the quarter dropped from 1 m still moves with the step, `stepped`'s too (docs/fidelity.md,
+// "Coins"): only second-order rim steps would converge there.
 inline constexpr double kContactStepPolyhedron = 3e-3;
 inline constexpr double kContactStepCurved = 2e-4;
 // sim.contact_tol > 0: a polyhedron's sustained contact in `impulse` is leapfrog with an
