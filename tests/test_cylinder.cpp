@@ -615,6 +615,55 @@ TEST(CylinderImpulse, CoinOnItsSideTwoPointSolveConverges) {
   }
 }
 
+// The dropped quarter's one unconverged solve of 10^5 `impulse` tosses at its 0.2 ms default (seed
+// 1, toss 18686): a start solve of a coin on its side rolling at 30 rad/s, both rims' lowest points
+// sliding at ~1 mm/s. From the slips before the solve, both-sliding's first normal split (rows 0.975
+// correlated) had the second point pulling, so solve_sliding dropped it for good; the sweeps and
+// Newton stalled, no other active set verified. solve_plastic_pair's last attempt, both sliding
+// from the sweeps' final slips, converges (9 iterations) on Gauss-Seidel's own answer (run on from
+// zero past its cap to convergence). The state replayed (the solve's input, warm start included),
+// then the toss.
+TEST(CylinderImpulse, CoinOnItsSideBothSlidingFromTheSweepsSlips) {
+  const DieModel m = compile(ready_coin("quarter.toml", {"sim.fidelity=\"impulse\""}));
+  RigidState s;
+  s.velocity = Vec3(0x1.bd9fac6ba2b1ap-3, 0x1.2b0dc8780ed3bp-2, -0x1.0073015fa294dp-9);
+  s.omega = Vec3(-0x1.804f0676efd56p+4, 0x1.1eb849596a786p+4, 0x1.dacd73c53c81bp+0);
+  const double R[9] = {-0x1.a81c26eb38ae3p-2, 0x1.b925ce8af8708p-2, -0x1.9a843eb70a463p-1,
+                       -0x1.1c820f8dda5d5p-1, 0x1.27f0034ac58bcp-1, 0x1.31f95d202d88p-1,
+                       0x1.711893187fafap-1,  0x1.62d74cd7f91cbp-1, 0x1.c3e2c6c39b4p-29};
+  for (int i = 0; i < 9; ++i) s.R(i / 3, i % 3) = R[i];
+  ContactSet c;
+  c.n = 2;
+  c.vertex[0] = 0;  // rim 0's lowest point
+  c.vertex[1] = 3;  // rim 1's
+  ContactImpulses warm, out;
+  warm.n = 2;
+  warm.vertex[0] = 0;
+  warm.vertex[1] = 3;
+  warm.P[0] = Vec3(0x1.41d9f8c7eb13ap-19, 0x1.3b7bf52c1b78dp-19, 0x1.7792879b3ef16p-17);
+  warm.P[1] = Vec3::Zero();
+  const double speed = s.velocity.norm() + s.omega.norm() * m.bounding_radius;
+  const ImpactResult r = apply_friction_impact(m, s, c, /*restitution=*/false, &warm, &out);
+  EXPECT_EQ(r.corrections.pgs_unconverged, 0u);
+  EXPECT_EQ(r.corrections.energy_clamps, 0u);
+  EXPECT_EQ(r.exact_fallbacks, 1);  // the pair's exact solve took it, counted
+  EXPECT_LE(r.energy_after, r.energy_before);
+  const double pn[2] = {4.463659129e-06, 6.613249296e-06};  // Gauss-Seidel's, converged
+  for (int i = 0; i < 2; ++i) {
+    const Vec3 u = corner_velocity(m, s, c.vertex[i]);
+    const double slip = std::hypot(u.x(), u.y());
+    EXPECT_NEAR(u.z(), 0.0, 1e-10 * speed) << i;
+    EXPECT_GT(slip, 5e-4) << i;  // both slide
+    EXPECT_NEAR(out.P[i].z(), pn[i], 1e-6 * pn[i]) << i;
+    // On the cone's edge, opposite the slip.
+    EXPECT_NEAR(std::hypot(out.P[i].x(), out.P[i].y()), m.max_friction * out.P[i].z(), 1e-9 * out.P[i].z()) << i;
+    EXPECT_LT(out.P[i].x() * u.x() + out.P[i].y() * u.y(), 0.0) << i;
+  }
+  const TossResult t = toss(m, 1, 18686);
+  EXPECT_EQ(t.status, TossStatus::Settled);
+  EXPECT_EQ(t.corrections.pgs_unconverged, 0u);  // read 1 before
+}
+
 // A cylinder's multi-point plastic solves by the direct solves (solve_sliding, solve_sticking;
 // tried when every point slips at least mu times its approach speed) against Gauss-Seidel's
 // converged solution of the same problem: a quarter-like coin and a thick one, on their side (the

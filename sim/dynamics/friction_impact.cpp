@@ -133,11 +133,16 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
       // the exact solve by their active sets, from the state before the solve. Only here, after
       // the sweeps, so that every converged solve is as it was.
       const RigidState gs = s;
+      Eigen::Vector2d gs_slip[2];  // the sweeps' final slips: the last attempt's start
+      for (int i = 0; i < 2; ++i) {
+        const Vec3 u = b.point_velocity(pts.r[i]);
+        gs_slip[i] = Eigen::Vector2d(u.x(), u.y());
+      }
       s.velocity = s0.velocity;
       s.omega = s0.omega;
       double qn[2];
       Eigen::Vector2d qt[2];
-      if (solve_plastic_pair(b, Iw, pts, speed, lever, qn, qt)) {
+      if (solve_plastic_pair(b, Iw, pts, speed, lever, qn, qt, gs_slip)) {
         for (int i = 0; i < 2; ++i) {
           pn[i] = qn[i];
           pt[i] = qt[i];

@@ -92,9 +92,10 @@ NewtonResult polish_newton(const Body& b, const Points& pts, double pn[], Eigen:
 // point sliding; two points by their active sets).
 bool solve_sticking(const Body& b, const Mat3& Iw, const Points& pts, double lever, double pn[],
                     Eigen::Vector2d pt[]);
-bool solve_sliding(const Body& b, const Points& pts, double speed, double lever, double pn[], Eigen::Vector2d pt[]);
+bool solve_sliding(const Body& b, const Points& pts, double speed, double lever, double pn[], Eigen::Vector2d pt[],
+                   const Eigen::Vector2d* start = nullptr);
 bool solve_plastic_pair(const Body& b, const Mat3& Iw, const Points& pts, double speed, double lever, double pn[],
-                        Eigen::Vector2d pt[]);
+                        Eigen::Vector2d pt[], const Eigen::Vector2d* gs_slip = nullptr);
 
 // friction_gauss_seidel.cpp: projected Gauss-Seidel, plastic and restitution friction.
 SweepResult solve_plastic(const Body& b, const Points& pts, double pn[], Eigen::Vector2d pt[], double radius,
