@@ -13,8 +13,10 @@
 
 #include "scenes_for_tests.hpp"
 #include "sim/body/die_model.hpp"
+#include "sim/body/rim.hpp"
 #include "sim/dynamics/contact.hpp"
 #include "sim/dynamics/contact_stepper.hpp"
+#include "sim/dynamics/rest.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/scene/scene.hpp"
 
@@ -248,6 +250,110 @@ inline RockingResult rocking_die(const SustainedFactory& make, double theta0 = 0
   }
   res.rel_error = (res.measured - res.expected) / res.expected;
   if (on_edge != 2) res.rel_error = 1.0;  // not the edge balance the check means
+  return res;
+}
+
+// e, f. The quarter upright on its band, where a dropped quarter's edge outcomes come from (issue
+// 39): the edge basin is the coin tilted less than atan(b' / a') ~ 3.24 deg (b', a': the core's
+// half-height and radius), its barrier only ~19 um of COM lift above standing straight up, and an
+// edge outcome is a coin whose energy fell below that barrier while it stayed in the band. The
+// quarter (scenes/coins/quarter.toml) starts with its axis horizontal but tilted up by `tilt`,
+// standing on the lower rim circle's lowest point, that point at rest on the floor.
+inline RigidState upright_quarter(const DieModel& m, double tilt, const Vec3& omega) {
+  RigidState s;
+  const Vec3 K(std::cos(tilt), 0.0, std::sin(tilt));  // the coin's axis, world
+  s.R = Quat::FromTwoVectors(m.rims.axis, K).toRotationMatrix();
+  s.position = Vec3(0.0, 0.0, -rim_lowest(m, s.R));
+  Vec3 r = contact_point(m, s.R, 0);
+  if (const Vec3 r3 = contact_point(m, s.R, 3); r3.z() < r.z()) r = r3;
+  s.omega = omega;
+  s.velocity = -s.omega.cross(r);
+  return s;
+}
+
+// E / (m g) as the "outcome settled" rule counts it (rim_rest.cpp): kinetic energy over m g plus
+// the COM height, a rim below the floor counted at the floor (m).
+inline double lift_energy(const DieModel& m, const RigidState& s) {
+  const double low = s.position.z() + rim_lowest(m, s.R);
+  return kinetic_energy(m, s) / (m.mass * m.gravity) + s.position.z() + std::max(0.0, -low);
+}
+
+// e. A wobbling roller: the quarter rolling like a wheel on its band (`roll` rad/s about its axis,
+// ~0.36 m/s at 30) with a tilt wobble (`tilt_rate` rad/s about the horizontal in its plane, so
+// the tilt swings across the band, ~+-3 deg, and its lowest point changes rim circle ~17 times a
+// second), no rolling or pivoting resistance. Then E = kinetic + m g z_COM only falls at the
+// rim changes (the other rim circle landing, a plastic contact below the impact threshold): a
+// step that starts on one rim circle should keep E. measured: E's change per second (lift units,
+// m/s) over `duration`, split by the steps' start: one rim circle on the floor (step error only),
+// both (the changes), neither; and the tilt's amplitude over the first and last tenth.
+struct RollerResult {
+  double one_rim = 0.0, two_rims = 0.0, none = 0.0;  // dE / (m g) per second (m/s)
+  double amp_start = 0.0, amp_end = 0.0;             // largest tilt in the first / last 10 % (rad)
+  long steps = 0;
+};
+inline DieModel upright_quarter_model(bool resistances) {
+  SceneDef def = load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter.toml");
+  if (!resistances)
+    for (auto& [name, mat] : def.materials) mat.rolling_resistance = mat.pivoting_resistance = 0.0;
+  return compile(def);
+}
+inline RollerResult wobbling_roller(const SustainedFactory& make, double roll = 30.0, double tilt = 1.0 * kPi / 180.0,
+                                    double tilt_rate = 2.0, double duration = 1.0) {
+  const DieModel m = upright_quarter_model(false);
+  const Vec3 K(std::cos(tilt), 0.0, std::sin(tilt));
+  RigidState s = upright_quarter(m, tilt, roll * K + tilt_rate * Vec3::UnitZ().cross(K).normalized());
+  const auto on_floor = [&](const RigidState& q) {
+    const RimFeatures rf(m, q.R);
+    const double tol = 1e-6;  // m: a rim circle's lowest point this close touches
+    return (q.position.z() + rf.point(0).z() < tol ? 1 : 0) + (q.position.z() + rf.point(3).z() < tol ? 1 : 0);
+  };
+  const auto tilt_of = [&](const RigidState& q) { return std::asin(std::min(1.0, std::abs((q.R * m.rims.axis).z()))); };
+  SustainedStep step = make(m);
+  RollerResult res;
+  double t = 0.0, de[3] = {0.0, 0.0, 0.0};
+  while (t < duration) {
+    const int k = on_floor(s);
+    const double e0 = lift_energy(m, s);
+    t += step(s);
+    ++res.steps;
+    de[k] += lift_energy(m, s) - e0;
+    if (t < 0.1 * duration) res.amp_start = std::max(res.amp_start, tilt_of(s));
+    if (t > 0.9 * duration) res.amp_end = std::max(res.amp_end, tilt_of(s));
+  }
+  res.none = de[0] / t;
+  res.one_rim = de[1] / t;
+  res.two_rims = de[2] / t;
+  return res;
+}
+
+// f. A spinning coin: the quarter (its own materials: rolling and pivoting resistance on) spinning
+// at `spin` rad/s about the vertical through its contact point, tilted `tilt`. It spins down
+// (pivoting resistance, the rim changes) and, below a spin of ~14 rad/s, tips out of the band and
+// falls flat, with its spin's energy still ~20x the barrier: it can end `edge` only if something
+// holds it in the band until the spin's energy, m a^2 w^2 / 8, falls below the barrier (w ~3 rad/s).
+// measured: the spin about the vertical (rad/s) when it fell (tilt past 30 deg) or was captured.
+struct SpinResult {
+  bool captured = false;  // the rest rule read `edge` (the side, face 2) before it fell
+  double spin = 0.0;      // |w_z| at the fall or the capture (rad/s)
+  double t = 0.0;
+  long steps = 0;
+};
+inline SpinResult spinning_upright(const SustainedFactory& make, double spin = 30.0, double tilt = 1.0 * kPi / 180.0,
+                                   double max_time = 40.0) {
+  const DieModel m = upright_quarter_model(true);
+  RigidState s = upright_quarter(m, tilt, Vec3(0.0, 0.0, spin));
+  SustainedStep step = make(m);
+  SpinResult res;
+  while (res.t < max_time) {
+    res.t += step(s);
+    ++res.steps;
+    const int f = rest_face_down(m, s, 0.5, kinetic_energy(m, s));
+    if (f >= 0 || std::abs((s.R * m.rims.axis).z()) > 0.5) {
+      res.captured = f == 2;
+      break;
+    }
+  }
+  res.spin = std::abs(s.omega.z());
   return res;
 }
 
