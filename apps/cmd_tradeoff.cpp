@@ -118,13 +118,17 @@ void plot_tradeoff_csv(const std::string& csv, const std::string& png, const std
       "set key below horizontal Left reverse font ',9'\n"
       "set grid\nset yrange [1e-3:2]\n"
       // One colour per fidelity (its rows are a ladder of one setting); each point labelled by its
-      // setting's value only, turned, so that the close ladders of impulse and stepped stay legible.
+      // setting's value only, turned: impulse's labels below its points, the others' above, so that
+      // the close ladders of impulse and stepped (both near the noise level) do not overprint.
       "val(s) = strstrt(s, '=') > 0 ? s[strstrt(s, '=') + 1:] : ''\n"
       "tv(f) = (strcol(1) eq f && column(5) > 0) ? column(5) : 1/0\n"
+      "other(f) = (strcol(1) ne f && column(5) > 0) ? column(5) : 1/0\n"
       "plot for [f in 'static paper impulse stepped'] '" + csv + "' skip 1 using 3:(tv(f)) with points pt 7 ps 1.3 "
       "title f, "
-      "'' skip 1 using 3:(column(5) > 0 ? column(5) : 1/0):(val(strcol(2))) with labels rotate by 35 left "
-      "offset char 0.6,0.5 font ',8' notitle, "
+      "'' skip 1 using 3:(other('impulse')):(val(strcol(2))) with labels rotate by 35 left offset char 0.6,0.5 font ',8' "
+      "notitle, "
+      "'' skip 1 using 3:(tv('impulse')):(val(strcol(2))) with labels rotate by -35 left offset char 0.6,-0.5 "
+      "font ',8' notitle, "
       "'' skip 1 using 3:6 with points pt 6 ps 1.5 lc rgb 'gray40' title 'noise level of the total variation', "
       "'' skip 1 using 3:(1 - column(4) > 0 ? 1 - column(4) : 1/0) with points pt 5 ps 0.8 lc rgb 'gray70' "
       "title '1 - same face fraction'\n";
