@@ -43,6 +43,15 @@ SceneDef load_coin(const std::string& file, std::vector<std::string> overrides =
   return ready_coin(file, overrides);
 }
 
+// Both rims' lowest points (features 0 and 3): a coin lying on its side.
+ContactSet both_rims() {
+  ContactSet c;
+  c.n = 2;
+  c.vertex[0] = 0;
+  c.vertex[1] = 3;
+  return c;
+}
+
 // A homogeneous coin scene (TOML), radius a, height h (m), extra lines appended.
 // The dynamic tests use a rolling resistance of 2 mm (a soft table) so that rolling ends soon.
 double g_rolling = 3e-4;
@@ -377,10 +386,7 @@ TEST(CylinderImpulse, FlatDiscNeverOnEdgeLongRodAlmostAlways) {
 TEST(CylinderImpulse, RollingResistanceOpposesOnlyTheRoll) {
   const DieModel m = coin_model(0.015, 0.0008);
   RigidState s = upright_on_rim(m);
-  ContactSet c;
-  c.n = 2;
-  c.vertex[0] = 0;
-  c.vertex[1] = 3;
+  const ContactSet c = both_rims();
   const double N = 1e-3;
   s.omega = Vec3(0.0, 0.7, 0.3);  // tipping and pivoting
   apply_rolling_resistance(m, s, c, N);
@@ -422,8 +428,7 @@ TEST(CylinderImpulse, PivotingResistanceOpposesOnlyTheSpinOnOnePoint) {
   s.omega = Vec3(0.0, 0.0, -1e-9);  // a spin it can stop: stopped, not reversed
   apply_pivoting_resistance(m, s, c, N);
   EXPECT_NEAR(s.omega.z(), 0.0, 1e-18);
-  c.n = 2;  // both rims' lowest points: lying on its side
-  c.vertex[1] = 3;
+  c = both_rims();  // lying on its side
   s.omega = Vec3(0.3, 0.0, 4.0);
   apply_pivoting_resistance(m, s, c, N);
   EXPECT_EQ(s.omega, Vec3(0.3, 0.0, 4.0));
@@ -588,10 +593,7 @@ TEST(CylinderImpulse, CoinOnItsSideTwoPointSolveConverges) {
     s.velocity = Vec3(k.vw[0], k.vw[1], k.vw[2]);
     s.omega = Vec3(k.vw[3], k.vw[4], k.vw[5]);
     for (int i = 0; i < 9; ++i) s.R(i / 3, i % 3) = k.R[i];
-    ContactSet c;
-    c.n = 2;
-    c.vertex[0] = 0;  // rim 0's lowest point
-    c.vertex[1] = 3;  // rim 1's
+    const ContactSet c = both_rims();
     ContactImpulses warm, out;
     warm.n = 1;
     warm.vertex[0] = 0;
@@ -632,10 +634,7 @@ TEST(CylinderImpulse, CoinOnItsSideBothSlidingFromTheSweepsSlips) {
                        -0x1.1c820f8dda5d5p-1, 0x1.27f0034ac58bcp-1, 0x1.31f95d202d88p-1,
                        0x1.711893187fafap-1,  0x1.62d74cd7f91cbp-1, 0x1.c3e2c6c39b4p-29};
   for (int i = 0; i < 9; ++i) s.R(i / 3, i % 3) = R[i];
-  ContactSet c;
-  c.n = 2;
-  c.vertex[0] = 0;  // rim 0's lowest point
-  c.vertex[1] = 3;  // rim 1's
+  const ContactSet c = both_rims();
   ContactImpulses warm, out;
   warm.n = 2;
   warm.vertex[0] = 0;
@@ -694,9 +693,7 @@ TEST(CylinderImpulse, RimDirectSolvesAreGaussSeidelsSolution) {
         s.omega = scale * 20.0 * Vec3(rng.normal(), rng.normal(), rng.normal());
         ContactSet c;
         if (side) {
-          c.n = 2;
-          c.vertex[0] = 0;
-          c.vertex[1] = 3;
+          c = both_rims();
         } else {
           const int down = (s.R * m.rims.axis).z() > 0.0 ? 0 : 1;  // the rim nearer the floor
           c.n = 3;

@@ -173,15 +173,17 @@ void FixedStepper::try_step_fixed(const RigidState& s0, const ContactSet& c, dou
     a.G = lowest_new(c, p, v, rot, d);
   else
     a.G = lowest_flat(c, p, v, s.R.row(2).transpose(), d);
-  s.position = p + d * v;
   // The COM's horizontal path with the step's mean velocity, not its end velocity: the solve at
   // the start stands for a force over the whole step (friction decelerating a sliding face), under
   // which the mean velocity is exact; the end velocity put a block sliding to rest short by
-  // v h / 2 each step (-0.88 % at 3 ms). Horizontally only: nothing in the model depends on where
-  // the die is on the floor (so no outcome changes), and the height, which the energy argument and
-  // the contact search use, keeps the end velocity. A curved die's support is not a force at the
-  // start (its curvature impulse acts inside the step, rim_support's path already holds it).
-  if (!built) s.position.head<2>() = p.head<2>() + (0.5 * d) * (s0.velocity.head<2>() + v.head<2>());
+  // mu g h^2 / 2 a step, v h / 2 in all (-0.88 % at 3 ms). Horizontally only: nothing in the
+  // model depends on where the die is on the floor (so no outcome changes), and the height, which
+  // the energy argument and the contact search use, keeps the end velocity. A curved die's support
+  // is not a force at the start (its curvature impulse acts inside the step, rim_support's path
+  // already holds it).
+  Vec3 path = v;
+  if (!built) path.head<2>() = 0.5 * (s0.velocity.head<2>() + v.head<2>());
+  s.position = p + d * path;
 }
 
 void FixedStepper::try_step_dkd(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full,
