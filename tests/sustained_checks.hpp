@@ -114,15 +114,19 @@ inline CheckResult sliding_block(const SustainedFactory& make, double v = 1.0, d
 // (tests/test_cylinder.cpp's EulersDiskPrecessesAtTheSteadyRate puts the contact at the corner of
 // the cylinder enlarged by the rounding; here it is the rounded rim's lowest point, the model's.)
 // measured: the azimuth of n advanced over `duration` (default 0.5 s, 6.5 turns at 30 deg: the
-// steady motion must be kept, not only started) divided by the time (unwrapped).
-// The quarter as Euler's disk uses it: high friction (mu), no rolling or pivoting resistance.
-inline DieModel euler_disk_model(double mu = 2.0) {
+// steady motion must be kept, not only started) divided by the time (unwrapped): euler_disk below.
+
+// The quarter (scenes/coins/quarter.toml), its rolling and pivoting resistance kept or removed.
+inline SceneDef quarter_scene(bool resistances) {
   SceneDef def = load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter.toml");
-  for (auto& [name, mat] : def.materials) {
-    mat.friction = mu;
-    mat.rolling_resistance = 0.0;
-    mat.pivoting_resistance = 0.0;
-  }
+  if (!resistances)
+    for (auto& [name, mat] : def.materials) mat.rolling_resistance = mat.pivoting_resistance = 0.0;
+  return def;
+}
+// The quarter as Euler's disk uses it: friction mu, no rolling or pivoting resistance.
+inline DieModel euler_disk_model(double mu = 2.0) {
+  SceneDef def = quarter_scene(false);
+  for (auto& [name, mat] : def.materials) mat.friction = mu;
   return compile(def);
 }
 
@@ -291,12 +295,7 @@ struct RollerResult {
   double amp_start = 0.0, amp_end = 0.0;             // largest tilt in the first / last 10 % (rad)
   long steps = 0;
 };
-inline DieModel upright_quarter_model(bool resistances) {
-  SceneDef def = load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter.toml");
-  if (!resistances)
-    for (auto& [name, mat] : def.materials) mat.rolling_resistance = mat.pivoting_resistance = 0.0;
-  return compile(def);
-}
+inline DieModel upright_quarter_model(bool resistances) { return compile(quarter_scene(resistances)); }
 inline RollerResult wobbling_roller(const SustainedFactory& make, double roll = 30.0, double tilt = 1.0 * kPi / 180.0,
                                     double tilt_rate = 2.0, double duration = 1.0) {
   const DieModel m = upright_quarter_model(false);
