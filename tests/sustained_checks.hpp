@@ -325,6 +325,20 @@ inline RollerResult wobbling_roller(const SustainedFactory& make, double roll = 
   return res;
 }
 
+// g. A rocking coin: the quarter standing on its band, no resistances, tilted `tilt` and released
+// at rest. It rocks between its two rim circles (the other circle landing slower than any impact
+// threshold: plastic), losing a little at each landing. measured: the lift it lost in `duration`,
+// E / (m g) at the start less at the end (m).
+inline double rocking_coin(const SustainedFactory& make, double tilt, double duration = 0.8) {
+  const DieModel m = upright_quarter_model(false);
+  RigidState s = upright_quarter(m, tilt, Vec3::Zero());
+  const double e0 = lift_energy(m, s);
+  SustainedStep step = make(m);
+  double t = 0.0;
+  while (t < duration) t += step(s);
+  return e0 - lift_energy(m, s);
+}
+
 // f. A spinning coin: the quarter (its own materials: rolling and pivoting resistance on) spinning
 // at `spin` rad/s about the vertical through its contact point, tilted `tilt`. It spins down
 // (pivoting resistance, the rim changes) and, below a spin of ~14 rad/s, tips out of the band and

@@ -78,20 +78,24 @@ RigidState upright_on_rim(const DieModel& m) {
 }
 
 // Tosses (seed 1) that clamped or lifted before a repair: each ends with no clamp and no lift, no
-// step gains energy, and the repair (`used`, a TossProbe counter) acted at least once.
-void expect_repaired(const DieModel& m, std::initializer_list<std::uint64_t> tosses, std::uint64_t TossProbe::*used) {
+// step gains energy, and the repair (`used`, a TossProbe counter; null: not asked) acted at least
+// once.
+void expect_repaired(const DieModel& m, std::initializer_list<std::uint64_t> tosses,
+                     std::uint64_t TossProbe::*used = nullptr) {
   for (const std::uint64_t i : tosses) {
     TossProbe probe;
     const TossResult r = toss(m, 1, i, &probe);
     EXPECT_EQ(r.corrections.energy_clamps, 0u) << i;
     EXPECT_EQ(r.corrections.overlap_fixes, 0u) << i;
-    EXPECT_GE(probe.*used, 1u) << i;
+    if (used) {
+      EXPECT_GE(probe.*used, 1u) << i;
+    }
     EXPECT_LE(probe.max_energy_gain, 1e-12) << i;
   }
 }
 
 // A `stepped` coin toss whose one solve once stalled unconverged: now settled, without any
-// correction, and the second method that took the solve counted in `used`.
+// correction, and the second method that took the solve counted in `used` (null: not asked).
 void expect_solved_by(const char* scene, std::uint64_t index, std::uint64_t TossProbe::*used) {
   const DieModel m =
       compile(load_scene(std::string(DICESIM_SOURCE_DIR) + scene, {"sim.fidelity=\"stepped\""}));
@@ -102,7 +106,9 @@ void expect_solved_by(const char* scene, std::uint64_t index, std::uint64_t Toss
   // No repair of the law (the sustained phase's guards, issue 39, may fire: a located step out of
   // trials is not a repair).
   EXPECT_EQ(r.corrections.energy_clamps + r.corrections.overlap_fixes + r.corrections.fallbacks, 0u) << scene << " " << index;
-  EXPECT_GE(probe.*used, 1u) << scene << " " << index;
+  if (used) {
+    EXPECT_GE(probe.*used, 1u) << scene << " " << index;
+  }
 }
 
 void expect_rel(double got, double want, double tol, const char* what) {
@@ -527,7 +533,10 @@ TEST(CylinderImpulse, SlappingFaceIsLocatedNotLifted) {
 // rest there) about a horizontal axis at 40 rad/s, with a component of 0.3-10 % along the
 // pivot's diameter so that the tilt passes zero at a distance (the lowest point runs round the
 // rim at the pass). Each lifted once or twice on ca346f7's stepper; the face's arrival is now an
-// impact. (Its capped near-half curvature impulses still count energy clamps: docs/fidelity.md.)
+// impact. On the first-order rim step the slap's location (slaps) struck it; on the
+// drift-kick-drift rim step (rim_step.cpp) no step of these six states is a located slap (slaps
+// 0), and the face is struck as a nearly flat face's tripod (flat_landed, FixedStepper::step):
+// with that strike disabled each clamps (1-5) and lifts (1-2). No clamp remains either.
 TEST(CylinderImpulse, SlappingFaceIsStruck) {
   const DieModel m = compile(ready_coin("quarter.toml"));
   for (const double tilt : {3e-3, 1e-3}) {
@@ -546,8 +555,9 @@ TEST(CylinderImpulse, SlappingFaceIsStruck) {
       for (int k = 0; k < 40; ++k) st.step(s);
       const std::string at = "tilt " + std::to_string(tilt) + " miss " + std::to_string(miss);
       EXPECT_EQ(st.corrections.overlap_fixes, 0u) << at;
+      EXPECT_EQ(st.corrections.energy_clamps, 0u) << at;
       EXPECT_EQ(st.corrections.pgs_unconverged, 0u) << at;
-      EXPECT_GE(st.slaps, 1u) << at;
+      EXPECT_GE(st.flat_landed, 1u) << at;  // the face's tripod struck
       EXPECT_GE(st.impacts, 1) << at;  // the face's arrival
       EXPECT_LE(st.max_energy_gain, 1e-12) << at;
     }
@@ -754,16 +764,17 @@ TEST(CylinderImpulse, FaceLandingFlatStrikesItsTripod) {
 }
 
 // A coin landing or lying nearly flat (tilt 1e-6 to 6e-5 rad) on one rim point: its rim's lowest
-// point runs round the rim while the face comes down, so the curvature impulse stayed capped after
-// the halvings (after a slap's located step had left the rest of the rim below and the plain step
-// ran instead) and the rim was lifted, 0.07-30 um. Now a step that would clamp or lift is taken
+// point runs round the rim while the face comes down, so the rim's support stayed capped after
+// the halvings and the rim was lifted, 0.07-30 um. Now a step that would clamp or lift is taken
 // again with the face's tripod struck when it reaches the floor within the step or lies that
-// close (FixedStepper::step). Every toss here clamped or lifted before (quarter `impulse`: all six
-// clamps and lifts of 2e4, seed 1; quarter-table: its only lift in 2e4); none does now. Three
-// take the tripod path; the other three no longer reach it, since the curvature impulse's energy
-// check counts a rim's depth below the floor (held energy): their first clamp was the rise of a
-// rim an earlier step had left below. (10377 reached it again once the rim's pivoting resistance
-// slowed its spin: its path changed, the outcome of the check did not.)
+// close (FixedStepper::step, flat_landed). The first six tosses here each clamped or lifted before
+// (quarter `impulse`: all six clamps and lifts of 2e4, seed 1; quarter-table: its only lift in
+// 2e4); none does now. On the drift-kick-drift rim step (rim_step.cpp) 10377, 19432 and
+// quarter-table's 16450 take the tripod path, 3259, 6927 and 10420 do not reach it (3259 took it
+// on the first-order step, 19432 did not). The rest are tosses of the same census (2e4 each,
+// seed 1: quarter 91 tosses struck so, quarter-table 27) whose tripod strike is not a kind B face
+// jump (face_jumped 0): each clamps and lifts once with the tripod's strike disabled (step()'s
+// two land_window_ retries), and none of the 2e4 clamps or lifts with it.
 TEST(CylinderImpulse, NearlyFlatFaceLandingIsStruckNotLifted) {
   const auto check = [](const char* scene, std::initializer_list<std::uint64_t> tosses, bool tripod) {
     const DieModel m =
@@ -782,33 +793,77 @@ TEST(CylinderImpulse, NearlyFlatFaceLandingIsStruckNotLifted) {
       EXPECT_LE(probe.max_energy_gain, 1e-12) << scene << " " << i;
     }
   };
-  check("quarter.toml", {3259u, 10377u}, true);
+  check("quarter.toml", {10377u, 19432u}, true);
   check("quarter-table.toml", {16450u}, true);
-  check("quarter.toml", {6927u, 10420u, 19432u}, false);
+  check("quarter.toml", {3259u, 6927u, 10420u}, false);
+  check("quarter.toml", {528u, 877u, 2474u, 2956u, 3800u}, true);
+  check("quarter-table.toml", {113u, 3831u, 6472u}, true);
 }
 
 // A near-flat coin spinning fast: the rim's lowest point runs round the rim, its height far from
-// quadratic over the step, and the curvature impulse's target for the exact end gap lies above the
-// point's reflection, so the impulse's own work gains (kind B of issue 13; not gravity's share of
-// a rolling coin, kind A). It was capped and counted as an energy clamp; now the step is halved
-// (unreflected, contact_stepper.cpp) and holds the rims without gaining. Tosses of
-// scenes/coins/quarter.toml (`impulse`, seed 1) that each clamped once on 470a8b3 (its other
-// clamping toss in the first 4000, 3259, still clamps after the halvings).
+// quadratic over the step, so the support that holds the rims on the floor at the step's end
+// would gain energy (kind B of issue 13; not gravity's share of a rolling coin, kind A). The
+// middle's support solve (mid_support, rim_step.cpp) is then capped, and where the cap leaves the
+// rims sinking the step is halved (contact_stepper.cpp, halve_while_capped) until it holds them
+// without gaining. Tosses of scenes/coins/quarter.toml (`impulse`, seed 1): 182, 389, 451, 597,
+// 1340 are halved on the drift-kick-drift rim step, and each clamps and lifts once (451: twice)
+// with the halvings disabled (kMaxHalvings 0): 68 of the 405 halved tosses of 2e4 do so, none
+// clamps or lifts with them. The earlier list, each clamping once on 470a8b3 (312, 695, 954, 2509,
+// 3289), still ends with no clamp and no lift; only 312 and 695 of them are halved now.
 TEST(CylinderImpulse, NearFlatCurvatureImpulseIsHalvedNotClamped) {
   const DieModel m =
       compile(load_coin("quarter.toml", {"sim.fidelity=\"impulse\""}));
-  expect_repaired(m, {312u, 695u, 954u, 2509u, 3289u}, &TossProbe::halved);
+  expect_repaired(m, {182u, 389u, 451u, 597u, 1340u}, &TossProbe::halved);
+  expect_repaired(m, {312u, 695u, 954u, 2509u, 3289u});
 }
 
-// A coin on its side whose other rim arrives: the located step is 1-10 ns long and starts with the
-// rim 0.6-1 nm below the floor (inside the touch tolerance). The curvature impulse asked the end
-// gap to close that depth within the step, work P |phi(0)| / d: 1-2 m/s of the rim, a gain, capped
-// and counted as an energy clamp, and each halving doubled the ask. It now holds the start's depth
-// when closing it would gain (depth_held). Tosses of scenes/coins/three-sided-coin.toml (`impulse`,
-// seed 1) that clamped so (1, 1 and 2 clamps) on 85acc6f.
-TEST(CylinderImpulse, ShortStepStartingBelowTheFloorHoldsItsDepth) {
+// A coin whose new contact is located to within nanoseconds: the located step ends with the rim on
+// the floor within the touch tolerance, possibly a little below it, and the next step may be as
+// short, starting there. The first-order rim step's curvature impulse asked such a step's end gap
+// to close that depth within it, work P |phi(0)| / d: 1-2 m/s of the rim, a gain, capped and
+// counted as an energy clamp (each halving doubled the ask), until it held the start's depth
+// (depth_held; three-sided coin `impulse` tosses 30004, 33883 and 97896, seed 1, clamped so 1, 1
+// and 2 times on 85acc6f). The drift-kick-drift rim step (rim_step.cpp) has no such ask: its
+// middle's support targets the rims' end gap within the touch tolerance, and depth_held is retired
+// (always 0). What remains to hold: such steps take no correction. Of 2e4 three-sided coin
+// `impulse` tosses (seed 1), 60 have an accepted step shorter than 1 us starting with the rim
+// below the floor (63 steps, 26-980 ns long, up to 0.99 nm deep: the touch tolerance is 1.06 nm),
+// and none clamps or lifts; these five are the first of them. The three tosses above no longer
+// take such a step, and end with no correction.
+TEST(CylinderImpulse, ShortStepStartingBelowTheFloorNeedsNoCorrection) {
   const DieModel m = compile(load_coin("three-sided-coin.toml"));
-  expect_repaired(m, {30004u, 33883u, 97896u}, &TossProbe::depth_held);
+  // Counts the accepted steps shorter than 1 us that start with the rim's lowest point below the
+  // floor, within the touch tolerance (their start: the previous step's end).
+  struct ShortSteps : StepObserver {
+    const DieModel* m = nullptr;
+    double t_last = -1.0;
+    RigidState last;
+    int below = 0;
+    bool deep = false;  // one started deeper than the touch tolerance
+    void on_step(double t, const RigidState& s) override {
+      const double dt = t - t_last;
+      if (t_last >= 0.0 && dt > 0.0 && dt < 1e-6) {
+        const double z = last.position.z() + rim_lowest(*m, last.R);
+        if (z < 0.0) ++below;
+        if (z < -1e-7 * m->bounding_radius) deep = true;
+      }
+      t_last = t;
+      last = s;
+    }
+  };
+  for (const std::uint64_t i : {527u, 869u, 1351u, 1507u, 1986u}) {
+    ShortSteps steps;
+    steps.m = &m;
+    TossProbe probe;
+    probe.steps_observer = &steps;
+    const TossResult r = toss(m, 1, i, &probe);
+    EXPECT_GE(steps.below, 1) << i;
+    EXPECT_FALSE(steps.deep) << i;
+    EXPECT_EQ(r.corrections.energy_clamps, 0u) << i;
+    EXPECT_EQ(r.corrections.overlap_fixes, 0u) << i;
+    EXPECT_LE(probe.max_energy_gain, 1e-12) << i;
+  }
+  expect_repaired(m, {30004u, 33883u, 97896u});
 }
 
 // The quarter that lands spinning upright about the vertical (2.4 % of quarter-table's `impulse`
@@ -876,29 +931,68 @@ TEST(CylinderStepped, NearFlatCurvatureImpulseIsHalvedNotClamped) {
   expect_repaired(m, {869u, 1829u}, &TossProbe::halved);
 }
 
-// A coin on its side whose two rims' points touch, one about to lift while the other slides: the
-// sweeps stall there (the pair's 0.975-correlated normal rows), and none of the pair's exact cases
-// verified: solve_sliding's iterate changed its active set after its first pass, and the one-point
-// case with the other lifting was rejected because the lifting point slips (plastic_verifies
-// asked friction of a point with no normal impulse). Quarter `stepped` toss 79149 (seed 1), the
-// one unconverged solve of its 10^5 tosses; it read pgs_unconverged 1 before.
 // A support search out of iterations takes its bracket's end above the floor (the rim ends a
 // little above it): not a correction of the law, but a guard, counted (support_search_capped).
-// Three-sided coin `impulse` toss 503 (seed 1) has one; toss 502 none.
+// Three-sided coin `impulse` toss 269 (seed 1) has one; toss 268 none. On the drift-kick-drift rim
+// step the search is mid_support's (rim_step.cpp); 21 of 2e4 tosses here have one each, all of
+// those examined (269, 570, 642, 2373, 2984) the eased push's search (b near -g d, the end gap
+// left at 2-4 touch tolerances below the floor after its 12 iterations). Toss 503, which had the
+// first-order step's one, has none now.
 TEST(CylinderImpulse, SupportSearchesOutOfIterationsAreCounted) {
   const DieModel m = compile(load_coin("three-sided-coin.toml"));
   TossProbe capped, plain;
-  const TossResult r = toss(m, 1, 503, &capped);
-  toss(m, 1, 502, &plain);
+  const TossResult r = toss(m, 1, 269, &capped);
+  toss(m, 1, 268, &plain);
   EXPECT_EQ(r.status, TossStatus::Settled);
   EXPECT_EQ(capped.support_search_capped, 1u);
   EXPECT_EQ(plain.support_search_capped, 0u);
   EXPECT_EQ(r.corrections.support_search_capped, 1u);  // reported with the corrections (issue 39)
 }
 
+// A coin on its side whose two rims' points touch, one about to lift while the other slides: the
+// sweeps stall there (the pair's 0.975-correlated normal rows), and none of the pair's exact cases
+// verified: solve_sliding's iterate changed its active set after its first pass, and the one-point
+// case with the other lifting was rejected because the lifting point slips (plastic_verifies
+// asked friction of a point with no normal impulse). Quarter `stepped` toss 79149 (seed 1), the
+// one unconverged solve of its 10^5 tosses; it read pgs_unconverged 1 before. The drift-kick-drift
+// rim step (rim_step.cpp) no longer reaches that solve in the toss (its exact_fallbacks read 0
+// now), so the solve is replayed: its input on 5e22320's first-order step (the toss's first pair
+// solve the exact method took, a start solve, with its warm start), which the exact solve still
+// takes, the first point lifting and the second sliding. The toss itself settles without any
+// correction.
 TEST(CylinderStepped, CoinOnItsSideOnePointLiftingSolvesExactly) {
-  // (The pair's exact solve after the sweeps, counted.)
-  expect_solved_by("/scenes/coins/quarter.toml", 79149, &TossProbe::exact_fallbacks);
+  const DieModel m =
+      compile(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/coins/quarter.toml", {"sim.fidelity=\"stepped\""}));
+  RigidState s;
+  s.velocity = Vec3(0x1.11bf82fda4bd3p-6, 0x1.78ec73edd1bdcp-5, -0x1.02302f2169255p-9);
+  s.omega = Vec3(-0x1.f0e3321008299p+1, 0x1.693c212f938e7p+0, 0x1.ce477b38386b7p+0);
+  const double R[9] = {0x1.8f0d3b136da66p-4,  0x1.521d36e971b43p-2, 0x1.e0b403d3ae036p-1,
+                       0x1.1012d8109051p-2,   0x1.cd0d79eae5c52p-1, -0x1.60865f2ce8df9p-2,
+                       -0x1.eb11f10b42475p-1, 0x1.21c98da04e7p-2,  -0x1.9bdc8d40dbp-27};
+  for (int i = 0; i < 9; ++i) s.R(i / 3, i % 3) = R[i];
+  const ContactSet c = both_rims();
+  ContactImpulses warm, out;
+  warm.n = 1;
+  warm.vertex[0] = 0;
+  warm.P[0] = Vec3(-0x1.8e47ae20e2086p-22, -0x1.d216f653961dcp-25, 0x1.07b847919ca07p-17);
+  const double speed = s.velocity.norm() + s.omega.norm() * m.bounding_radius;
+  const ImpactResult r = apply_friction_impact(m, s, c, /*restitution=*/false, &warm, &out);
+  EXPECT_EQ(r.corrections.pgs_unconverged, 0u);
+  EXPECT_EQ(r.corrections.fallbacks, 0u);
+  EXPECT_EQ(r.corrections.energy_clamps, 0u);
+  EXPECT_EQ(r.exact_fallbacks, 1);  // the pair's exact solve took it, counted
+  EXPECT_LE(r.energy_after, r.energy_before);
+  // The first point lifts: no impulse, leaving the floor.
+  EXPECT_EQ(out.P[0].norm(), 0.0);
+  EXPECT_GT(corner_velocity(m, s, c.vertex[0]).z(), 0.0);
+  // The second slides, held on the floor: its impulse on the cone's edge, opposite the slip.
+  const Vec3 u = corner_velocity(m, s, c.vertex[1]);
+  EXPECT_NEAR(u.z(), 0.0, 1e-10 * speed);
+  EXPECT_GT(std::hypot(u.x(), u.y()), 1e-4);
+  EXPECT_NEAR(out.P[1].z(), 1.1152507836e-05, 1e-6 * 1.1152507836e-05);
+  EXPECT_NEAR(std::hypot(out.P[1].x(), out.P[1].y()), m.max_friction * out.P[1].z(), 1e-9 * out.P[1].z());
+  EXPECT_LT(out.P[1].x() * u.x() + out.P[1].y() * u.y(), 0.0);
+  expect_solved_by("/scenes/coins/quarter.toml", 79149, nullptr);
 }
 
 // A coin landing flat on its tripod whose restitution friction Gauss-Seidel leaves unconverged and
@@ -915,11 +1009,17 @@ TEST(CylinderStepped, TripodDualKeepsTheRoundThatVerifies) {
 // rad/s about a nearly horizontal axis on one rim point, its lowest point jumping across the face
 // within microseconds, so the curvature impulse gained by its own work even after four halvings
 // and was capped (clamped). The step is now taken again with the face struck when one tripod
-// point reaches the floor within it (FixedStepper::step, face_jumped). Every clamping toss of 10^5
-// (seed 1) in these rows on e802e6a but one, each clamping once (some also lifting once): `impulse`
-// three-sided coin (10 tosses) and quarter (2), `stepped` three-sided coin (3) and quarter (4).
+// point reaches the floor within it (FixedStepper::step, face_jumped). The second list of each row:
+// every clamping toss of 10^5 (seed 1) in these rows on e802e6a but one, each clamping once (some
+// also lifting once): `impulse` three-sided coin (10 tosses) and quarter (2), `stepped` three-sided
+// coin (3) and quarter (4); they still end with no correction. On the drift-kick-drift rim step
+// (rim_step.cpp) only 5070 and 17582 of them take the face jump; the first list of each row is
+// tosses of a census that do (seed 1, tosses 0..2e4 of each row: 41, 60, 13 and 18 tosses, none
+// clamping or lifting), each of the listed ones clamping once (some also lifting) with the face
+// jump disabled.
 TEST(CylinderImpulse, NearFlatJumpingLowestPointStrikesTheFace) {
-  const auto check = [](const char* scene, const char* fidelity, std::initializer_list<std::uint64_t> tosses) {
+  const auto check = [](const char* scene, const char* fidelity, std::initializer_list<std::uint64_t> tosses,
+                        bool jumped) {
     const DieModel m = compile(load_coin(scene,
                                           {std::string("sim.fidelity=\"") + fidelity + "\""}));
     for (const std::uint64_t i : tosses) {
@@ -928,15 +1028,21 @@ TEST(CylinderImpulse, NearFlatJumpingLowestPointStrikesTheFace) {
       EXPECT_EQ(r.corrections.energy_clamps, 0u) << scene << " " << fidelity << " " << i;
       EXPECT_EQ(r.corrections.overlap_fixes, 0u) << scene << " " << fidelity << " " << i;
       EXPECT_EQ(r.corrections.pgs_unconverged, 0u) << scene << " " << fidelity << " " << i;
-      EXPECT_GE(probe.face_jumped, 1u) << scene << " " << fidelity << " " << i;
+      if (jumped) {
+        EXPECT_GE(probe.face_jumped, 1u) << scene << " " << fidelity << " " << i;
+      }
       EXPECT_LE(probe.max_energy_gain, 1e-12) << scene << " " << fidelity << " " << i;
     }
   };
+  check("three-sided-coin.toml", "impulse", {107u, 1138u, 1520u, 1996u, 2244u, 5070u}, true);
   check("three-sided-coin.toml", "impulse",
-        {5070u, 22160u, 28556u, 28574u, 38189u, 40059u, 53741u, 87911u, 90802u, 93160u});
-  check("quarter.toml", "impulse", {27865u, 57637u});
-  check("three-sided-coin.toml", "stepped", {8749u, 57083u, 62560u});
-  check("quarter.toml", "stepped", {17582u, 49162u, 70241u, 71547u});
+        {22160u, 28556u, 28574u, 38189u, 40059u, 53741u, 87911u, 90802u, 93160u}, false);
+  check("quarter.toml", "impulse", {382u, 593u, 1840u}, true);
+  check("quarter.toml", "impulse", {27865u, 57637u}, false);
+  check("three-sided-coin.toml", "stepped", {880u, 1185u, 3482u}, true);
+  check("three-sided-coin.toml", "stepped", {8749u, 57083u, 62560u}, false);
+  check("quarter.toml", "stepped", {1709u, 2606u, 3289u, 17582u}, true);
+  check("quarter.toml", "stepped", {49162u, 70241u, 71547u}, false);
 }
 
 // A quarter landing exactly flat (tilt ~5e-7 rad) on a table at 2.3-2.7 m/s, spinning at 340-410
@@ -947,7 +1053,12 @@ TEST(CylinderImpulse, NearFlatJumpingLowestPointStrikesTheFace) {
 // hold it (capped after four halvings) and the rim ended 1-3 nm below the floor (lifted). The
 // step is now taken again with the rim's most approaching points struck as well
 // (FixedStepper::strike_rim). Quarter-table `stepped`, seed 1: the five tosses of 10^5 that
-// clamped and lifted once each on 1051139.
+// clamped and lifted once each on 1051139. On the drift-kick-drift rim step (rim_step.cpp) the rim
+// strike fires in none of them, nor in any of 2e4 quarter-table `stepped` tosses (seed 1; nor in
+// 2e4 each of quarter-table and quarter `impulse`, quarter `stepped` and three-sided coin
+// `impulse`): these tosses settle without a correction, 485, 41167, 51816 and 76034 with the
+// face's tripod struck as a nearly flat face's (flat_landed), without which each clamps and lifts
+// once; 12317 needs neither.
 TEST(CylinderStepped, FlatCoinsSpinOverStrikesTheRimBetweenTheTripod) {
   const DieModel m = compile(load_coin("quarter-table.toml",
                                         {"sim.fidelity=\"stepped\""}));
@@ -961,7 +1072,9 @@ TEST(CylinderStepped, FlatCoinsSpinOverStrikesTheRimBetweenTheTripod) {
               0u)
         << i;
     EXPECT_LE(probe.max_energy_gain, 1e-12) << i;
-    EXPECT_GE(probe.rim_struck, 1u) << i;  // by the rim strike, and counted
+    if (i != 12317u) {
+      EXPECT_GE(probe.flat_landed, 1u) << i;  // the face's tripod struck, counted
+    }
   }
 }
 

@@ -55,7 +55,7 @@ double relative_gain(double before, double after) {
   return before > 0.0 ? (after - before) / before : (after > 0.0 ? after : 0.0);
 }
 
-// Leapfrog: a corner the last step's solve pushed (warm, P_z > 0) stays in the contact set while
+// Leapfrog and rim steps: a corner the last step's solve pushed (warm, P_z > 0) stays in the contact set while
 // it lies within `hold` of the floor, though above the touch tolerance. The leapfrog's bias holds
 // such a corner's end height to second order only (leapfrog_bias: the solve's own change of the
 // spin moves it by (a_n after - a_n before) d^2 / 8, ~1e-9 m a step on a rocking die): without
@@ -78,7 +78,7 @@ void keep_held(const DieModel& m, const RigidState& s, const ContactImpulses& wa
 
 // Trials of the shortened step's length (each a whole step) before taking the best one.
 constexpr int kMaxTrials = 12;
-// Halvings of a curved die's step whose curvature impulse was capped (step()).
+// Halvings of a curved die's step whose support was capped (step()).
 constexpr int kMaxHalvings = 4;
 
 int FixedStepper::step(RigidState& s) { return step(s, kinetic_energy(*m_, s)); }
@@ -88,7 +88,12 @@ int FixedStepper::step(RigidState& s, double ke) {
   ContactSet c;
   if (s.position.z() <= m.bounding_radius + touch_tol_ && !(soa_vertices_ > 0 && soa_touching(s, c)))
     c = touching_corners(m, s, touch_tol_);
-  if (leapfrog() && !m.curved() && warm_.n > 0) keep_held(m, s, warm_, 1e-6 * m.bounding_radius, c);
+  // A curved die's too, within 1e-5 r: its rim steps hold only the lower of two touching rim
+  // circles exactly on the floor (one bias for the solve), the other within ~w^2 r h^2 / 8 (4e-6 r
+  // at 30 rad/s and 0.2 ms). With the flat dice's 1e-6 r the three-sided coin's second circle left
+  // the set and landed again, located, 765 times a toss (2 016 without any hold; 8 at 1e-5 r).
+  if ((leapfrog() || m.curved()) && warm_.n > 0)
+    keep_held(m, s, warm_, (m.curved() ? 1e-5 : 1e-6) * m.bounding_radius, c);
   const bool relanded = land_window_ > 0.0;  // this is the step taken again (below)
   const bool struck = rim_strike_;  // ... or taken again with the rim struck (below)
   rim_strike_ = false;
@@ -174,7 +179,7 @@ int FixedStepper::step(RigidState& s, double ke) {
   double dt = h_;
   // The search for a new contact's instant (below), run again as the plain step's if a slap's
   // located step leaves the rest of its rim below the floor (then the far half was not the first
-  // part to arrive: the lowest point ran round the rim, a roll, which the curvature impulse holds).
+  // part to arrive: the lowest point ran round the rim, a roll, which the middle's support holds).
   const auto locate = [&] {
     done = &a_;
     dt = h_;
@@ -336,7 +341,7 @@ int FixedStepper::step(RigidState& s, double ke) {
     if (sink > std::max(max_sink_, touch_tol_)) ++held_sinks;
     if (h_ < h_max_) ++short_steps;
   }
-  // The accepted step halved (at most kMaxHalvings times) while its capped curvature impulse
+  // The accepted step halved (at most kMaxHalvings times) while its capped support
   // leaves the rims sinking (why it happens: below).
   const auto halve_while_capped = [&] {
     Attempt* buf = done == &b_ ? &lo_ : &b_;
@@ -350,7 +355,7 @@ int FixedStepper::step(RigidState& s, double ke) {
     }
     ++halved;
   };
-  // A slap's step whose near half the capped curvature impulse leaves sinking: halved as a plain
+  // A slap's step whose near half the capped support leaves sinking: halved as a plain
   // step would be, still a slap's (its end then before the far half's arrival).
   if (slap_rims_ != 0 && done->to_halve()) halve_while_capped();
   if (slap_rims_ != 0 && done->s.position.z() + rim_lowest(m, done->s.R) < -touch_tol_) {
@@ -361,15 +366,11 @@ int FixedStepper::step(RigidState& s, double ke) {
   }
   if (m.curved() && done->to_halve() && slap_rims_ == 0) {
     // (Not a slap's step: its end is the far half's arrival, which a halving would miss.)
-    // The curvature impulse could not hold the rims on the floor without gaining energy: the
-    // lowest point's height is far from quadratic over the step (a near-flat coin spinning fast,
-    // its lowest point running round the rim: the slap), or the step's gravity, kicked at its
-    // start, is out of phase with the middle's impulse by g P d / 2 (a disc rolling on its rim
-    // with w^2 a >> g, Euler's disk). Shorter steps, halved (at most kMaxHalvings times) until it
-    // holds; what is still below the floor then is lifted, counted (overlap_fixes). Halved as well
-    // (unreflected) while the impulse's own work gains, though the capped one holds the rims: the
-    // near-flat coin's, which a shorter step removes (kind B, issue 13: quarter `impulse` 2e4
-    // tosses 32 -> 6 clamps); the gravity-phase cap, which it does not, is left to be counted.
+    // The middle's support could not hold the rims on the floor without gaining energy beyond
+    // the step's bound: the lowest point's height is far from quadratic over the step (a near-flat
+    // coin spinning fast, its lowest point running round the rim: the slap). Shorter steps, halved
+    // (at most kMaxHalvings times) until it holds; what is still below the floor then is lifted,
+    // counted (overlap_fixes).
     halve_while_capped();
   }
   // A curved die's rims at the accepted step's end, below the floor by this (lifted at the end).
@@ -453,6 +454,8 @@ int FixedStepper::step(RigidState& s, double ke) {
   }
   const Attempt& a = *done;
   s = a.s;
+  rim_slip_ = a.slip;
+  rim_slip_vertex_ = a.slip_vertex;
   if (a.impact) {
     ++impacts;
     corrections.add(a.imp.corrections);
@@ -461,7 +464,7 @@ int FixedStepper::step(RigidState& s, double ke) {
     exact_fallbacks += static_cast<std::uint64_t>(a.imp.exact_fallbacks);
     max_energy_gain = std::max(max_energy_gain, relative_gain(a.imp.energy_before, a.imp.energy_after));
   }
-  // An accepted step whose curvature impulse was capped (to gain no energy) is a clamp, counted
+  // An accepted step whose support was capped (to gain no energy) is a clamp, counted
   // as the start's are (the step itself then holds the rims with less than the exact end gap).
   if (a.clamped) ++corrections.energy_clamps;
   if (c.n > 0) {

@@ -12,9 +12,9 @@
 // Energy: no step gains mechanical energy E = kinetic + m g z_com (the rotation is exact, a step
 // without contact loses m g^2 h^2 / 2, the plastic solve after gravity's kick loses at least
 // (F - m g h)^2 / 2m with F its normal impulse, and no impact gains). `max_energy_gain` records
-// the largest relative gain seen, for the tests. (A curved die's rim, whose lowest point is not a
-// material point, is held on the floor by an impulse at the step's middle that does no work to
-// second order; checked, and capped if it would gain: rim_support, curvature_support.)
+// the largest relative gain seen, for the tests. (A curved die's steps are drift-kick-drift, second
+// order, their support solve at the step's middle: rim_step.cpp. Such a step may gain up to
+// m (g h)^2 / 8, split_gain; checked, and capped beyond it.)
 #pragma once
 
 #include <optional>
@@ -124,13 +124,11 @@ class FixedStepper {
   double max_step_rise = 0.0;
   double max_rise_excess = 0.0;
   double max_penetration = 0.0;   // curved dice: deepest lowest point below the floor at a step's end (m)
-  std::uint64_t curvature_impulses = 0;  // curved dice: mid-step curvature impulses (rim_support)
-  std::uint64_t curvature_capped = 0;    // ... of them capped to gain no energy
-  std::uint64_t start_capped = 0;        // curved dice: start solves capped to gain no energy (energy_clamps)
-  // Curved dice: support searches (start_support's reduced push, curvature_support's impulse) out
-  // of iterations, their bracket's end above the floor taken (the rim ends a little above it); any trial.
+  std::uint64_t curvature_capped = 0;    // curved dice: support solves at a step's middle capped to gain no energy (any trial)
+  // Curved dice: support searches (mid_support's push or eased push) out of iterations, their
+  // bracket's end above the floor taken (the rim ends a little above it); any trial.
   std::uint64_t support_search_capped = 0;
-  std::uint64_t halved = 0;              // curved dice: steps halved because the cap left them sinking (or unreflected)
+  std::uint64_t halved = 0;              // curved dice: steps halved because the cap left them sinking
   std::uint64_t slaps = 0;               // curved dice: steps shortened to a slapping face's arrival
   // Curved dice: the slap's two re-decisions (step()): the plain step taken because a slap's far
   // half does not reach the floor within the full step, and the plain step's search run again
@@ -141,7 +139,7 @@ class FixedStepper {
   // taken again from their start with the face's tripod struck because it reaches the floor
   // within the step or lies that close (step(): a coin landing or lying nearly flat).
   std::uint64_t flat_landed = 0;
-  // Curved dice: of those, the steps whose curvature impulse gained by its own work after the
+  // Curved dice: of those, the steps whose support gained by its own work after the
   // halvings (kind B, issue 13: a near-flat coin's lowest point jumping across the face) and whose
   // face arrives within the step at one tripod point (the other may be rising).
   std::uint64_t face_jumped = 0;
@@ -151,8 +149,8 @@ class FixedStepper {
   // again with that arc struck too (step(), strike_rim); and those not kept.
   std::uint64_t rim_struck = 0;
   std::uint64_t rim_strike_declined = 0;
-  // Curved dice: curvature impulses that held a start's depth below the floor (within the touch
-  // tolerance) because closing it within the step would gain energy (curvature_support).
+  // Curved dice: retired with the first-order rim step's curvature impulse (which held a start's
+  // depth when closing it gained energy); always 0, kept for the reports' and the wire's layout.
   std::uint64_t depth_held = 0;
   // Impacts whose restitution friction was taken by the dual solve (Gauss-Seidel stalled).
   std::uint64_t dual_solves = 0;
@@ -175,7 +173,7 @@ class FixedStepper {
   // half the kick's speed at the step's middle. 0 for fixed steps (their solve after the whole kick
   // never gains).
   double split_gain(double d) const {
-    return leapfrog() ? 0.125 * m_->mass * (m_->gravity * d) * (m_->gravity * d) : 0.0;
+    return leapfrog() || m_->curved() ? 0.125 * m_->mass * (m_->gravity * d) * (m_->gravity * d) : 0.0;
   }
   // The longest step (<= h_max_) whose held corners, moving with the die's free rotation from the
   // step's start, sink no more than max_sink_ below the floor within it (to second order in d;
@@ -196,16 +194,16 @@ class FixedStepper {
     ImpactResult imp, sup;
     ContactImpulses next;
     double G = 0.0;  // lowest height at the step's end over corners not in c
-    bool capped = false;  // curved: the curvature impulse was capped and left the rims below the floor
-    bool clamped = false; // curved: the curvature impulse was capped (to gain no energy) at all
-    // curved: capped because its own kinetic work would gain (its target above the point's
-    // reflection: the lowest point's height far from quadratic over the step); the step is halved
-    // (step()), and a clamp counted only if the halvings do not remove it
-    bool unreflected = false;
-    bool to_halve() const { return capped || unreflected; }  // step() halves it (halve_while_capped)
+    bool capped = false;  // curved: the middle's support was capped and left the rims below the floor
+    bool clamped = false; // curved: the middle's support was capped (to gain no energy) at all
+    bool to_halve() const { return capped; }  // step() halves it (halve_while_capped)
     bool risen = false;   // flat: the held corners were asked to rise (try_step); else the plain solve
     bool rise_dropped = false;  // flat: they could not be without gaining energy (the plain solve instead)
     double held_e = 0.0;  // risen: held_energy of s (its check in try_step_with)
+    // curved, one rim point in c: its slip after the middle's solve (the next step reflects the
+    // change from it, mid_support), and which feature it was (-1: none)
+    Eigen::Vector2d slip = Eigen::Vector2d::Zero();
+    int slip_vertex = -1;
   };
   void try_step(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full = false);
   // try_step_with's leapfrog step from a.s = s0 (a flat die): the free motion for d / 2 (start_rot_), the
@@ -235,19 +233,21 @@ class FixedStepper {
   // Its fixed (first-order) step from a.s = s0: the kick g d and the support solve there, then the
   // free motion for d.
   void try_step_fixed(const RigidState& s0, const ContactSet& c, double d, Attempt& a, bool full, double bias);
-  // A curved die's support solve for a step of length d (gravity's kick already in s): the plastic
-  // solve, rolling and pivoting resistance, and the touching rims' lowest points held on the floor
-  // at the step's end by the curvature impulse at the step's middle (rim_support.cpp). Leaves
-  // s and rot such that rot's free motion of s for d is the step's motion. full: the step of
-  // length h (it decides rims_new_).
-  void rim_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
-                   std::optional<TorqueFreeRotation>& rot, bool full);
-  // Its parts: the solve at the step's start (plastic, biased to hold the rims on the floor), and
-  // the curvature impulse at the step's middle for what the start leaves sinking.
-  void start_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
-                     std::optional<TorqueFreeRotation>& rot);
-  void curvature_support(RigidState& s, const ContactSet& c, double d, double e_start, Attempt& a,
-                         std::optional<TorqueFreeRotation>& rot);
+  // A curved die's step of length d from a.s (its start, after the impact), drift-kick-drift
+  // (rim_step.cpp): a plastic impulse for a point of c that arrives approaching, the free motion
+  // for d / 2, gravity's whole kick and the support solve there (rim_support), the free motion
+  // of the result for d / 2. Sets a.G at the end. full: the step of length h.
+  void try_step_rim(const ContactSet& c, double d, Attempt& a, bool full);
+  // The support solve at the step's middle, s (the kick in it), for the d left of the step
+  // (mid_support), then, for the full step, whether the sinking is another part of the rim
+  // arriving (rims_new_). Leaves s and rot such that rot's free motion of s for d is the rest of
+  // the step. geo: the contact set-up at s.R.
+  void rim_support(RigidState& s, const ContactSet& c, double d, Attempt& a, std::optional<TorqueFreeRotation>& rot,
+                   bool full, ContactGeometry& geo);
+  // Plastic, with the rims' resistances; asked to leave the touching rims' lowest points on the
+  // floor at the end, a single point's slip reflected; no gain beyond split_gain (rim_step.cpp).
+  void mid_support(RigidState& s, const ContactSet& c, double d, Attempt& a, std::optional<TorqueFreeRotation>& rot,
+                   ContactGeometry& geo);
   // The model of G(d) from the full step's free motion: its lowest new corner at t, raised by what
   // the smaller gravity kick of a step of length t changes, g (h - t) t. Exact for a step without
   // contact (the rotation is the same); with contact the solve absorbs part of the kick.
@@ -296,7 +296,7 @@ class FixedStepper {
   // more than 90 deg with slap_u_[rim] (the rim's lowest point at the slap's start), in closed form.
   // rim < 0: the near half of rim -rim - 1 instead.
   double slap_low(const Vec3& z_row, int rim) const;
-  // The touching rim's lowest point the curvature impulse holds: the whole rim, or in a slap the
+  // The touching rim's lowest point the middle's support holds: the whole rim, or in a slap the
   // near half (the far half is the arriving part).
   double support_low(const Vec3& z_row, int rim) const;
   // The lowest height over corners not in c, at time t of the free motion after the step's solve.
@@ -346,6 +346,8 @@ class FixedStepper {
   double end_ke_ = 0.0;  // step(): the kinetic energy of the state it returns
   Mat3 rot_start_ = Mat3::Identity();  // orientation at the start of the step being tried
   Mat3 Iw_start_ = Mat3::Identity();   // its world inertia (every trial's angular momentum)
+  Eigen::Vector2d rim_slip_ = Eigen::Vector2d::Zero();  // the accepted step's Attempt::slip
+  int rim_slip_vertex_ = -1;                              // ... and slip_vertex
   double e_start_ = 0.0;                // its mechanical energy after the impact (the trials' checks)
   Attempt a_, b_, lo_;                  // trial steps (members: ContactImpulses is large)
   ContactImpulses warm_;  // the last plastic solve's impulses (warm start of the next)
@@ -433,8 +435,8 @@ struct StepperStats {
   double max_step_rise = 0.0;    // FixedStepper::max_step_rise (m)
   double max_rise_excess = 0.0;  // FixedStepper::max_rise_excess (relative)
   double max_penetration = 0.0;  // curved dice: deepest lowest point below the floor at a step's end (m)
-  // Curved dice, adaptive steps (not corrections): steps halved because a capped curvature impulse
-  // left the rims sinking, curvature impulses capped (in any trial), steps shortened to a slap.
+  // Curved dice, adaptive steps (not corrections): steps halved because a capped support left the
+  // rims sinking, supports at a step's middle capped (in any trial), steps shortened to a slap.
   std::uint64_t halved = 0;
   std::uint64_t curvature_capped = 0;
   std::uint64_t support_search_capped = 0;  // support searches out of iterations, the end above the floor taken
@@ -446,7 +448,7 @@ struct StepperStats {
   std::uint64_t face_jump_declined = 0;  // kind B steps taken again with the face struck, not kept
   std::uint64_t rim_struck = 0;          // tripod impacts taken again with the rim's approaching arc struck
   std::uint64_t rim_strike_declined = 0;  // ... taken again but not kept
-  std::uint64_t depth_held = 0;       // curvature impulses that held a start's depth (closing it gained)
+  std::uint64_t depth_held = 0;       // retired (the first-order rim step's): always 0
   std::uint64_t dual_solves = 0;      // impacts whose restitution friction the dual solve took
   std::uint64_t exact_fallbacks = 0;  // accepted steps' solves an exact second method took (ImpactResult)
   // Flat dice (not corrections: a step's discretisation, reported): the deepest held corner below

@@ -113,7 +113,8 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   a.impact = impact_;
   if (impact_) a.imp = imp_;
   a.next.n = 0;
-  a.capped = a.clamped = a.unreflected = false;
+  a.capped = a.clamped = false;
+  a.slip_vertex = -1;
   a.risen = bias != 0.0 || !slip_bias_.isZero();  // (fixed steps: bias >= 0, no slip)
   a.rise_dropped = false;
   if (leapfrog()) {
@@ -131,13 +132,14 @@ void FixedStepper::try_step_fixed(const RigidState& s0, const ContactSet& c, dou
                                   double bias) {
   const DieModel& m = *m_;
   RigidState& s = a.s;  // (s0 until the kick)
+  if (m.curved() && c.n > 0) {  // a rim's step is drift-kick-drift (rim_step.cpp)
+    try_step_rim(c, d, a, full);
+    return;
+  }
   s.velocity.z() -= kick_g_ * d;
-  // Built in place (the full step's is kept for model_G; the object is large, so no copies). A
-  // curved die's support solve builds its own (rim_support: the rotation is part of its search).
+  // Built in place (the full step's is kept for model_G; the object is large, so no copies).
   std::optional<TorqueFreeRotation>& slot = full ? full_rot_ : trial_rot_;
-  const bool built = m.curved() && c.n > 0;
-  if (built) rim_support(s, c, d, e_start_, a, slot, full);
-  if (!m.curved() && c.n > 0) {
+  if (c.n > 0) {
     s.velocity.z() -= bias;
     a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next, &geo_);
     s.velocity.z() += bias;
@@ -145,8 +147,7 @@ void FixedStepper::try_step_fixed(const RigidState& s0, const ContactSet& c, dou
   // Free motion for d: straight COM, exact torque-free rotation (kinetic energy exact). A trial of
   // a step without contact has the full step's rotation exactly (the same s0.R and, with no
   // impulse, the same angular momentum): it is reused.
-  const TorqueFreeRotation& rot = built                             ? *slot
-                                  : !full && c.n == 0 && full_rot_ ? *full_rot_
+  const TorqueFreeRotation& rot = !full && c.n == 0 && full_rot_ ? *full_rot_
                                                                     : slot.emplace(moments_, s.R,
                                                                                    Vec3(Iw_start_ * s.omega), full);
   rot_start_ = s.R;
@@ -178,11 +179,10 @@ void FixedStepper::try_step_fixed(const RigidState& s0, const ContactSet& c, dou
   // which the mean velocity is exact; the end velocity put a block sliding to rest short by
   // mu g h^2 / 2 a step, v h / 2 in all (-0.88 % at 3 ms). Horizontally only: nothing in the
   // model depends on where the die is on the floor (so no outcome changes), and the height, which
-  // the energy argument and the contact search use, keeps the end velocity. A curved die's support
-  // is not a force at the start (its curvature impulse acts inside the step, rim_support's path
-  // already holds it).
+  // the energy argument and the contact search use, keeps the end velocity. (A curved die in
+  // contact takes try_step_rim's drift-kick-drift instead.)
   Vec3 path = v;
-  if (!built) path.head<2>() = 0.5 * (s0.velocity.head<2>() + v.head<2>());
+  path.head<2>() = 0.5 * (s0.velocity.head<2>() + v.head<2>());
   s.position = p + d * path;
 }
 

@@ -21,9 +21,9 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
   const double set_tol = 1e-6 * m.bounding_radius;  // corners this close strike together
   // A polyhedron's sustained contact: leapfrog steps of error-controlled length (contact_tol), the
   // contact step their ceiling, and the impact threshold a fixed speed (the shape's default step),
-  // whatever the ceiling. A curved die keeps fixed first-order steps of contact_step (its rim
-  // support's energy argument assumes the whole kick before the solve: with half kicks the quarter
-  // on a table clamped millions of times), and its threshold 4 g contact_step.
+  // whatever the ceiling. A curved die's steps are drift-kick-drift at the fixed contact_step
+  // (FixedStepper, rim_step.cpp: second order without error control), its threshold 4 g
+  // contact_step.
   const bool adaptive_steps = !m.curved() && m.contact_tol > 0.0;
   const double v_sustained = sustained_contact_speed(m, adaptive_steps ? m.sustained_step : m.contact_step);
   const AdaptiveSteps adaptive{.tol = adaptive_steps ? m.contact_tol : 0.0,

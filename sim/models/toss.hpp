@@ -77,8 +77,8 @@ struct TossProbe {
   double max_step_rise = 0.0;    // plain kinetic + m g z over one fixed step: its largest rise / (m g) (m)
   double max_rise_excess = 0.0;  // ... its largest relative excess over m g (the deepest held corner's start depth)
   double max_penetration = 0.0;  // curved dice: deepest rim below the floor at any fixed step's end (m)
-  std::uint64_t halved = 0;            // curved dice: fixed steps halved (a capped curvature impulse)
-  std::uint64_t curvature_capped = 0;  // curved dice: curvature impulses capped to gain no energy (any trial)
+  std::uint64_t halved = 0;            // curved dice: fixed steps halved (a capped support)
+  std::uint64_t curvature_capped = 0;  // curved dice: supports at a step's middle capped to gain no energy (any trial)
   std::uint64_t support_search_capped = 0;  // curved dice: support searches out of iterations (end above the floor taken; any trial)
   std::uint64_t slaps = 0;             // curved dice: fixed steps shortened to a slapping face's arrival
   std::uint64_t slap_no_arrival = 0;   // curved dice: slaps whose far half did not arrive (the plain step taken)
@@ -88,7 +88,7 @@ struct TossProbe {
   std::uint64_t face_jump_declined = 0;  // kind B steps taken again with the face struck but not kept
   std::uint64_t rim_struck = 0;          // a flat coin's tripod impact taken again with its rim's approaching arc struck
   std::uint64_t rim_strike_declined = 0;  // ... taken again but not kept
-  std::uint64_t depth_held = 0;        // curved dice: curvature impulses that held a start's depth below the floor
+  std::uint64_t depth_held = 0;        // retired (the first-order rim step's curvature impulse): always 0
   std::uint64_t dual_solves = 0;       // impacts whose restitution friction the dual solve took (Gauss-Seidel stalled)
   std::uint64_t exact_fallbacks = 0;   // solves an exact second method took (ImpactResult::exact_fallbacks)
   double max_held_sink = 0.0;          // flat dice: deepest held corner below the floor at any fixed step's end (m)

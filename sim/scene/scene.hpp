@@ -151,10 +151,9 @@ struct FloorDef {
 // where the die's spin would sink them: contact_stepper.hpp), and at 3 ms its faces are where a
 // 10x finer step puts them on Dice 1-3, the fair die and the d20 (docs/fidelity.md, "Convergence
 // as equivalence tests").
-// A cylinder's rim rolls continuously, first order in the step: 0.2 ms holds Euler's disk within
-// 0.3 % and the quarter on a table's edge rate within 0.2 p_edge of `stepped` (10^5 tosses; 0.5 ms
-// not), but the quarter dropped from 1 m still moves with the step, `stepped`'s too (docs/fidelity.md,
-// "Coins"): only second-order rim steps would converge there.
+// A cylinder's rim steps are drift-kick-drift, second order (rim_step.cpp): the quarter dropped
+// from 1 m reads the same edge rate at 1, 0.5, 0.2 and 0.1 ms (docs/fidelity.md, "Coins"); 0.2 ms
+// is kept as the default until its equivalence with 1 ms is shown at 10^5 tosses.
 inline constexpr double kContactStepPolyhedron = 3e-3;
 inline constexpr double kContactStepCurved = 2e-4;
 // sim.contact_tol > 0: a polyhedron's sustained contact in `impulse` is leapfrog with an
@@ -164,7 +163,8 @@ inline constexpr double kContactStepCurved = 2e-4;
 // contact's instant, may be shorter). 0 (the default): fixed first-order steps of the contact step.
 // Experimental, not the default: on five dice at 3*10^5 tosses it leaves the faces where fixed
 // 3 ms steps put them, at 2.5-2.7x the cost, and its energy bound is m (g h)^2 / 8 a step rather
-// than rounding (docs/fidelity.md, "Leapfrog steps"). Curved dice ignore it.
+// than rounding (docs/fidelity.md, "Leapfrog steps"). Curved dice ignore it (their steps are
+// always drift-kick-drift, at the fixed contact step).
 inline constexpr double kContactTolDefault = 0.0;
 inline constexpr double kContactStepFloor = 1e-4;
 
