@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "aggregator/counts_json.hpp"
 #include "messages/wire.hpp"
 
 namespace dicesim::agg {
@@ -36,33 +37,16 @@ std::vector<std::uint8_t> from_hex(const std::string& s) {
   return b;
 }
 
-// Every field of RunCounts: a field added there (e.g. counted corrections, or N outcomes instead
-// of 6) must be added here and in counts_from, or a resumed run would lose it. The assertion
-// makes such a change stop here until it is.
-static_assert(sizeof(RunCounts) == sizeof(std::vector<std::uint64_t>) + 4 * sizeof(std::uint64_t) + sizeof(RunCorrections) &&
-                  sizeof(RunCorrections) == RunCorrections::kKinds * sizeof(std::uint64_t),
-              "RunCounts changed: serialise the new fields in counts_json / counts_from");
+// The five count fields are counts_json.hpp's (shared with shard files); the corrections here are
+// an array in for_each order.
 json counts_json(const RunCounts& c) {
-  const RunCorrections& k = c.corrections;
-  return {{"faces", c.faces},
-          {"settled", c.settled},
-          {"unresolved", c.unresolved},
-          {"invalid", c.invalid},
-          {"bounces", c.bounces},
-          {"corrections", [&] {
-             json a = json::array();  // corrections.hpp's for_each order
-             k.for_each([&](const char*, std::uint64_t n) { a.push_back(n); });
-             return a;
-           }()}};
+  json a = json::array();
+  c.corrections.for_each([&](const char*, std::uint64_t n) { a.push_back(n); });
+  return agg::count_fields_json(c, std::move(a));
 }
 
 RunCounts counts_from(const json& j) {
-  RunCounts c;
-  c.faces = j.at("faces").get<std::vector<std::uint64_t>>();
-  c.settled = j.at("settled").get<std::uint64_t>();
-  c.unresolved = j.at("unresolved").get<std::uint64_t>();
-  c.invalid = j.at("invalid").get<std::uint64_t>();
-  c.bounces = j.at("bounces").get<std::uint64_t>();
+  RunCounts c = agg::count_fields_from(j);
   // The kinds in for_each order; a checkpoint written before the sustained phase's guards were
   // counted holds the first four (the rest start at 0).
   const auto k = j.at("corrections").get<std::vector<std::uint64_t>>();

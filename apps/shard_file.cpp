@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "aggregator/counts_json.hpp"
 #include "messages/run_spec.hpp"
 #include "sim/scene/scene.hpp"
 
@@ -17,18 +18,12 @@
 namespace dicesim {
 namespace {
 
-nlohmann::json counts_json(const RunCounts& c) {
-  return {{"faces", c.faces},     {"settled", c.settled}, {"unresolved", c.unresolved},
-          {"invalid", c.invalid}, {"bounces", c.bounces}, {"corrections", corrections_json(c.corrections)}};
-}
+// The five count fields are aggregator/counts_json.hpp's (shared with checkpoints); the
+// corrections here are an object by name, as the report prints them.
+nlohmann::json counts_json(const RunCounts& c) { return agg::count_fields_json(c, corrections_json(c.corrections)); }
 
 RunCounts counts_from(const nlohmann::json& j) {
-  RunCounts c;
-  c.faces = j.at("faces").get<std::vector<std::uint64_t>>();
-  c.settled = j.at("settled").get<std::uint64_t>();
-  c.unresolved = j.at("unresolved").get<std::uint64_t>();
-  c.invalid = j.at("invalid").get<std::uint64_t>();
-  c.bounces = j.at("bounces").get<std::uint64_t>();
+  RunCounts c = agg::count_fields_from(j);
   // Every kind, by the names corrections_json writes (the first four alone dropped the sustained
   // phase's guards from a merged report).
   const auto& k = j.at("corrections");

@@ -37,6 +37,7 @@ PageServer::PageServer(const LiveBoard& board) : impl_(std::make_unique<Impl>())
   s->http.Get("/", [](const httplib::Request&, httplib::Response& res) {
     std::string page(kServeHtml);
     const auto at = [&](std::string_view key) { return page.find(key); };
+    page.replace(at("@TITLE@"), 7, "dicesim serve");
     page.replace(at("@CSS@"), 5, kServeCss);
     page.replace(at("@SERVE@"), 7, kServeJs);
     res.set_content(page, "text/html; charset=utf-8");

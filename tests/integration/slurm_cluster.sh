@@ -11,20 +11,12 @@
 set -euo pipefail
 [ -n "${DICESIM_TRACE:-}" ] && set -x
 
-skip() {
-  if [ -n "${CI:-}" ]; then echo "FAIL: cannot run under CI=$CI: $1" >&2; exit 1; fi
-  echo "SKIP: $1"; exit 77
-}
-if [ "${DICESIM_NETNS:-}" != "1" ]; then
-  if [ "$(id -u)" -ne 0 ]; then skip "network namespaces and slurmd need root"; fi
-  unshare --net true 2> /dev/null || skip "cannot make a network namespace here (unshare --net failed)"
-  exec unshare --net env DICESIM_NETNS=1 "$0" "$@"
-fi
+net_multicast=off  # private_net.sh: lo without multicast (Slurm needs none)
+. "$(dirname "$0")/private_net.sh" slurm "$@"
 bin=$(readlink -f "$1") shards=$2 tosses=$3 mode=${4:-toss}
 for p in munged mungekey slurmctld slurmd sbatch squeue; do
   command -v "$p" > /dev/null || skip "no $p (Debian packages slurm-wlm and munge)"
 done
-ip link set lo up
 # Slurm binds its ports through getaddrinfo(AI_ADDRCONFIG), which finds no address family when the
 # only interface is loopback: a veth pair with both ends in this namespace (nothing can leave) gives it one.
 ip link add dicesim0 type veth peer name dicesim1
@@ -32,19 +24,14 @@ ip addr add 10.255.255.1/32 dev dicesim0
 ip link set dicesim0 up
 ip link set dicesim1 up
 
-src_dir=$(cd "$(dirname "$0")/../.." && pwd)
-cd "$src_dir"
-work=$(mktemp -d "/tmp/dicesim-slurm-XXXXXX")
 chmod 755 "$work"
-pids=()
-cleanup() {
+cleanup() {  # slurmctld, slurmd and munged get a TERM first; DICESIM_KEEP keeps the work folder
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
   sleep 1
   for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done
   wait 2>/dev/null || true
   [ -n "${DICESIM_KEEP:-}" ] || rm -rf "$work"
 }
-trap cleanup EXIT
 fail() { echo "FAIL [slurm]: $*" >&2; for f in "$work"/*.log "$work"/parts/*.log; do [ -f "$f" ] && { echo "--- $f" >&2; tail -n 15 "$f" >&2; }; done; exit 1; }
 
 # munge: a fresh key, a socket of its own.

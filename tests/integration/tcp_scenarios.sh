@@ -15,37 +15,16 @@
 #   no_multicast   proof of the setup: a UDP multicast run cannot even start here
 # Under CI=true a scenario that cannot run (no root, no namespace, no java) fails.
 set -euo pipefail
-
-skip() {
-  if [ -n "${CI:-}" ]; then echo "FAIL: cannot run under CI=$CI: $1" >&2; exit 1; fi
-  echo "SKIP: $1"; exit 77
-}
-if [ "${DICESIM_NETNS:-}" != "1" ]; then
-  if [ "$(id -u)" -ne 0 ]; then skip "network namespaces need root"; fi
-  unshare --net true 2> /dev/null || skip "cannot make a network namespace here (unshare --net failed)"
-  exec unshare --net env DICESIM_NETNS=1 "$0" "$@"
-fi
+net_multicast=off  # private_net.sh: lo without multicast, no 224/4 route
+. "$(dirname "$0")/private_net.sh" tcp "$@"
 bin=$1 inject=$2 scenario=$3
 command -v java > /dev/null || skip "no java (Debian package default-jre-headless)"
 [ -f "${DICESIM_LCM_JAR:-/usr/share/java/lcm.jar}" ] || skip "no LCM jar (Debian package liblcm-java)"
 command -v nft > /dev/null || skip "no nft (Debian package nftables)"
 
-ip link set lo up
-ip link set lo multicast off
 nft add table inet dicesim_nomc
 nft add chain inet dicesim_nomc out '{ type filter hook output priority 0; policy accept; }'
 nft add rule inet dicesim_nomc out ip daddr 224.0.0.0/4 counter drop
-
-src_dir=$(cd "$(dirname "$0")/../.." && pwd)
-cd "$src_dir"
-work=$(mktemp -d "/tmp/dicesim-tcp-XXXXXX")
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$work"
-}
-trap cleanup EXIT
 
 port=7700
 export LCM_DEFAULT_URL="tcpq://127.0.0.1:$port"
