@@ -128,7 +128,6 @@ nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
           {"flat_landed_per_toss", static_cast<double>(probe.flat_landed) / np},
           // Curvature impulses that held a start's depth below the floor (within the touch
           // tolerance) because closing it within a short step would gain energy.
-          {"depth_held_per_toss", static_cast<double>(probe.depth_held) / np},
           // Clamped near-flat steps taken again with the face struck (kind B): kept, and declined
           // (the step restored and finished as before).
           {"face_jumped_per_toss", static_cast<double>(probe.face_jumped) / np},
@@ -191,13 +190,13 @@ void print_text(const nlohmann::json& r) {
   if (r["fixed_steps_per_toss"].get<double>() > 0) {
     std::printf("  fixed steps/toss    %.1f\n", r["fixed_steps_per_toss"].get<double>());
     std::printf("    located %.3f (out of trials %.4f)  halved %.3f  capped curvature %.3f  support searches out of "
-                "iterations %.4f  slaps %.3f (no arrival %.4f, rim below %.4f)  landed flat %.4f  depth held %.4f  face "
+                "iterations %.4f  slaps %.3f (no arrival %.4f, rim below %.4f)  landed flat %.4f  face "
                 "struck %.4f (declined %.4f)  rim struck %.4f (declined %.4f)  balances nudged %.4f (per toss)\n",
                 r["located_steps_per_toss"].get<double>(), r["located_capped_per_toss"].get<double>(),
                 r["halved_steps_per_toss"].get<double>(), r["curvature_capped_per_toss"].get<double>(),
                 r["support_search_capped_per_toss"].get<double>(), r["slaps_per_toss"].get<double>(),
                 r["slap_no_arrival_per_toss"].get<double>(), r["slap_rim_below_per_toss"].get<double>(),
-                r["flat_landed_per_toss"].get<double>(), r["depth_held_per_toss"].get<double>(),
+                r["flat_landed_per_toss"].get<double>(),
                 r["face_jumped_per_toss"].get<double>(), r["face_jump_declined_per_toss"].get<double>(),
                 r["rim_struck_per_toss"].get<double>(), r["rim_strike_declined_per_toss"].get<double>(),
                 r["nudges_per_toss"].get<double>());
@@ -307,7 +306,7 @@ void register_bench(CLI::App& app, int& exit_code) {
                 "nudges_per_toss, "
                 "halved_steps_per_toss, curvature_capped_per_toss, support_search_capped_per_toss,\n"
                 "slaps_per_toss, slap_no_arrival_per_toss,\n"
-                "slap_rim_below_per_toss, flat_landed_per_toss, depth_held_per_toss, face_jumped_per_toss,\n"
+                "slap_rim_below_per_toss, flat_landed_per_toss, face_jumped_per_toss,\n"
                 "face_jump_declined_per_toss, rim_struck_per_toss, rim_strike_declined_per_toss, dual_solves,\n"
                 "exact_fallbacks,\n"
                 "phases {name: {share, per_toss, us_each}},\n"

@@ -149,9 +149,6 @@ class FixedStepper {
   // again with that arc struck too (step(), strike_rim); and those not kept.
   std::uint64_t rim_struck = 0;
   std::uint64_t rim_strike_declined = 0;
-  // Curved dice: retired with the first-order rim step's curvature impulse (which held a start's
-  // depth when closing it gained energy); always 0, kept for the reports' and the wire's layout.
-  std::uint64_t depth_held = 0;
   // Impacts whose restitution friction was taken by the dual solve (Gauss-Seidel stalled).
   std::uint64_t dual_solves = 0;
   // Solves of accepted steps (impacts and supports) that an exact second method took
@@ -448,7 +445,6 @@ struct StepperStats {
   std::uint64_t face_jump_declined = 0;  // kind B steps taken again with the face struck, not kept
   std::uint64_t rim_struck = 0;          // tripod impacts taken again with the rim's approaching arc struck
   std::uint64_t rim_strike_declined = 0;  // ... taken again but not kept
-  std::uint64_t depth_held = 0;       // retired (the first-order rim step's): always 0
   std::uint64_t dual_solves = 0;      // impacts whose restitution friction the dual solve took
   std::uint64_t exact_fallbacks = 0;  // accepted steps' solves an exact second method took (ImpactResult)
   // Flat dice (not corrections: a step's discretisation, reported): the deepest held corner below

@@ -22,7 +22,7 @@ struct CorrectionCounts {
   Count located_capped = 0;          // a new contact not located within the touch tolerance in the trials allowed
   Count support_search_capped = 0;   // curved dice: a support search out of iterations (its end above the floor taken)
   Count rise_dropped = 0;            // flat dice: held corners' rise dropped (it would gain energy), the plain step taken
-  Count depth_held = 0;              // curved dice: a start's depth held (closing it within the step would gain energy)
+  Count depth_held = 0;              // retired with the first-order rim step (nothing sets it: 0); kept for the wire's and checkpoints' layout
   Count nudges = 0;                  // an exact balance at rest broken by the toss's tiebreak (a spin of 1e-4 sqrt(g/r))
 
   static constexpr std::size_t kKinds = 9;

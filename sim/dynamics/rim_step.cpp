@@ -195,6 +195,14 @@ void FixedStepper::mid_support(RigidState& s, const ContactSet& c, double d, Att
     return;
   }
   if (!(d > 0.0) || g0 <= touch_tol_ || !(a.sup.normal_impulse > 0.0)) {
+    // The plain solve, checked like the searches' results: a plastic solve at the middle keeps
+    // within the bound, but the reflected slip's impulse may not. Where it gains, the slip is
+    // stopped instead (no bias), counted as an energy clamp.
+    if (!bt.isZero() && gains()) {
+      bt.setZero();
+      solve(0.0);
+      ++a.sup.corrections.energy_clamps;
+    }
     done();
     return;
   }

@@ -54,7 +54,6 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->face_jump_declined += st.face_jump_declined;
       stats->rim_struck += st.rim_struck;
       stats->rim_strike_declined += st.rim_strike_declined;
-      stats->depth_held += st.depth_held;
       stats->dual_solves += st.dual_solves;
       stats->exact_fallbacks += st.exact_fallbacks;
       stats->max_held_sink = std::max(stats->max_held_sink, st.max_held_sink);
@@ -67,7 +66,6 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
       stats->corrections.located_capped += static_cast<std::uint32_t>(st.located_capped);
       stats->corrections.support_search_capped += static_cast<std::uint32_t>(st.support_search_capped);
       stats->corrections.rise_dropped += static_cast<std::uint32_t>(st.rise_dropped);
-      stats->corrections.depth_held += static_cast<std::uint32_t>(st.depth_held);
       stats->corrections.nudges += static_cast<std::uint32_t>(out.nudges);
     }
     return out;

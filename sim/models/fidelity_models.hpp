@@ -41,7 +41,6 @@ inline void add_stepper_stats(TossProbe& probe, const StepperStats& stats) {
   probe.face_jump_declined += stats.face_jump_declined;
   probe.rim_struck += stats.rim_struck;
   probe.rim_strike_declined += stats.rim_strike_declined;
-  probe.depth_held += stats.depth_held;
   probe.dual_solves += stats.dual_solves;
   probe.exact_fallbacks += stats.exact_fallbacks;
 }

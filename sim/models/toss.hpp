@@ -88,7 +88,6 @@ struct TossProbe {
   std::uint64_t face_jump_declined = 0;  // kind B steps taken again with the face struck but not kept
   std::uint64_t rim_struck = 0;          // a flat coin's tripod impact taken again with its rim's approaching arc struck
   std::uint64_t rim_strike_declined = 0;  // ... taken again but not kept
-  std::uint64_t depth_held = 0;        // retired (the first-order rim step's curvature impulse): always 0
   std::uint64_t dual_solves = 0;       // impacts whose restitution friction the dual solve took (Gauss-Seidel stalled)
   std::uint64_t exact_fallbacks = 0;   // solves an exact second method took (ImpactResult::exact_fallbacks)
   double max_held_sink = 0.0;          // flat dice: deepest held corner below the floor at any fixed step's end (m)
