@@ -362,6 +362,9 @@ class FixedStepper {
   // Leapfrog: the held corners' tangential velocity at the step's middle (leapfrog_bias, the
   // tangential part of the bias; try_step sets it for try_step_dkd's solve).
   Eigen::Vector2d slip_bias_ = Eigen::Vector2d::Zero();
+  // Leapfrog: a horizontal spin (rad/s, world) added to the solve's target with slip_bias_ and the
+  // normal bias, so that each held corner is asked for its own rise (leapfrog_bias).
+  Vec3 tilt_bias_ = Vec3::Zero();
   // Leapfrog: start_rot_'s state at mid_d_ / 2 (the bias's, try_step), reused by try_step_dkd's
   // first half drift of the same trial; mid_d_ < 0: none.
   Mat3 mid_R_ = Mat3::Identity();

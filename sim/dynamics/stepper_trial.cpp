@@ -29,18 +29,30 @@ namespace {
 // floor - k (z / d + v / 2), which takes (z, v d) to (z (1 - k / 2) + v d (1 - k / 2) / 2, -k z -
 // k v d / 2), eigenvalues 0 and 1 - k: back to the floor without oscillation (closing the
 // middle's gap alone reflects v every step, a period-2 oscillation that never decays); below it
-// - k v / 2 only (try_step adds the depth's own term, the shallowest corner's). k = d / span: over
-// the ceiling's length, as the depth (with k = 1 the bias varied as 1 / d across a located step's
-// trials, and a Die 1 toss took 2.56 trials per located step instead of 2.29). The solve shifts every corner alike: the
-// normal part is the most any corner asks, the tangential part that corner's. (The spin the solve
-// makes is not in a: predicted from the last step's impulses it sank held corners 50 um, after a
-// sub-threshold landing whose impulse was no force.)
-Vec3 leapfrog_bias(const DieModel& m, const RigidState& s0, const ContactSet& c, const Mat3& R_mid, const Vec3& w,
-                   double d, double k) {
+// - k v / 2 and its depth over span (a single corner: the depth term is try_step's, shallow). k =
+// d / span: over the ceiling's length, as the depth (with k = 1 the bias varied as 1 / d across a
+// located step's trials, and a Die 1 toss took 2.56 trials per located step instead of 2.29).
+// Two or more corners (an edge, a face) are each asked for their own rise: the solve's target is
+// shifted by a rigid motion, a rise b at the COM plus a horizontal spin W (tilt), which matches
+// affine asks exactly, as every ask is across one edge or face. With one rise for all (the most
+// any corner asked) a face that landed tilted stayed tilted, its corners 0.2-3 um apart for the
+// rest of the contact: never "lying flat" (rest.cpp, 1e-6 r), so a Die 1 toss took ~6 four-corner
+// steps (each a Gauss-Seidel solve) before the energy rule ended it. The tangential part is the
+// most-asking corner's acceleration term, less what W moves the corners sideways. (The spin the
+// solve makes is not in a: predicted from the last step's impulses it sank held corners 50 um,
+// after a sub-threshold landing whose impulse was no force.)
+struct LeapfrogBias {
+  Vec3 B;     // the shift of the solve's target velocity at the COM: tangential slip, normal rise b
+  Vec3 tilt;  // W, horizontal (rad/s, world): the shift of its spin
+};
+LeapfrogBias leapfrog_bias(const DieModel& m, const RigidState& s0, const ContactSet& c, const Mat3& R_mid,
+                           const Vec3& w, double d, double k, double shallow_term, double span, double touch_tol) {
   const double half = 0.5 * d;
   const Vec3 wb = R_mid.transpose() * w;
   const Vec3 alpha = R_mid * (-(wb.cross(Vec3(m.principal_moments.cwiseProduct(wb)))).cwiseQuotient(m.principal_moments));
-  Vec3 B(0.0, 0.0, -std::numeric_limits<double>::infinity());
+  LeapfrogBias out{Vec3(0.0, 0.0, -std::numeric_limits<double>::infinity()), Vec3::Zero()};
+  double ask[kMaxContacts];
+  Vec3 rm[kMaxContacts];
   for (int i = 0; i < c.n; ++i) {
     const Vec3 r = contact_point(m, R_mid, c.vertex[i]);
     const Vec3 r0 = contact_point(m, s0.R, c.vertex[i]);
@@ -48,9 +60,51 @@ Vec3 leapfrog_bias(const DieModel& m, const RigidState& s0, const ContactSet& c,
     const double v = (s0.velocity + s0.omega.cross(r0)).z();
     const Vec3 a = w.cross(w.cross(r)) + alpha.cross(r);
     const double bn = z > 0.0 ? -a.z() * half - k * (z / d + 0.5 * v) : -a.z() * half - 0.5 * k * v;
-    if (bn > B.z()) B = Vec3(-a.x() * half, -a.y() * half, bn);
+    if (bn > out.B.z()) out.B = Vec3(-a.x() * half, -a.y() * half, bn);
+    rm[i] = r;
+    ask[i] = std::min(bn + (z < -touch_tol ? -z / span : 0.0), m.gravity * d);
   }
-  return B;
+  if (c.n < 2) {
+    out.B.z() += shallow_term;
+    return out;
+  }
+  // The asks as b0 + (W x r_i)_z: along an edge W is normal to it; on a face, least squares (exact:
+  // depth, acceleration and velocity are affine across a rigid face).
+  double b0;
+  Vec3 W = Vec3::Zero();
+  if (c.n == 2) {
+    const Vec3 e = rm[1] - rm[0];
+    const double e2 = e.x() * e.x() + e.y() * e.y();
+    if (e2 > 0.0) {
+      const double s = (ask[1] - ask[0]) / e2;
+      W = Vec3(s * e.y(), -s * e.x(), 0.0);  // (W x e)_z = W_x e_y - W_y e_x
+    }
+  } else {
+    Eigen::Matrix<double, Eigen::Dynamic, 3> A(c.n, 3);
+    Eigen::VectorXd b(c.n);
+    for (int i = 0; i < c.n; ++i) {
+      A(i, 0) = 1.0;
+      A(i, 1) = rm[i].y() / m.bounding_radius;
+      A(i, 2) = -rm[i].x() / m.bounding_radius;
+      b(i) = ask[i];
+    }
+    const Eigen::Vector3d x = A.colPivHouseholderQr().solve(b);
+    W = Vec3(x(1) / m.bounding_radius, x(2) / m.bounding_radius, 0.0);
+  }
+  // The rise at the COM: every corner at least its ask.
+  b0 = -std::numeric_limits<double>::infinity();
+  double rz = 0.0;
+  for (int i = 0; i < c.n; ++i) {
+    b0 = std::max(b0, ask[i] - W.cross(rm[i]).z());
+    rz += rm[i].z();
+  }
+  rz /= c.n;
+  out.B.z() = b0;
+  // The spin shift moves the corners horizontally by rz (W_y, -W_x): taken out of the slip's.
+  out.B.x() -= rz * W.y();
+  out.B.y() += rz * W.x();
+  out.tilt = W;
+  return out;
 }
 
 }  // namespace
@@ -71,6 +125,7 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
   // step, which never gains kinetic + m g z (counted, rise_dropped; its corners' depth stays).
   if (full) full_bias_ = 0.0;
   slip_bias_ = Eigen::Vector2d::Zero();
+  tilt_bias_ = Vec3::Zero();
   mid_d_ = -1.0;
   if (!hold_ || m.curved() || c.n == 0) {
     try_step_with(s0, c, d, a, full, 0.0);
@@ -85,9 +140,11 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
     // (leapfrog_bias), replaces a_down_'s term; negative where the pivot's acceleration lifts it.
     start_rot_->state(0.5 * d, mid_R_, mid_w_);
     mid_d_ = d;
-    const Vec3 B = leapfrog_bias(m, s0, c, mid_R_, mid_w_, d, d / span);
-    slip_bias_ = B.head<2>();
-    b = std::min(start_shallow_ / span + B.z(), m.gravity * d);
+    const LeapfrogBias lb =
+        leapfrog_bias(m, s0, c, mid_R_, mid_w_, d, d / span, start_shallow_ / span, span, touch_tol_);
+    slip_bias_ = lb.B.head<2>();
+    tilt_bias_ = lb.tilt;
+    b = std::min(lb.B.z(), m.gravity * d);
   } else {
     b = std::min(start_shallow_ / span + 0.5 * a_down_ * d, m.gravity * d);
   }
@@ -97,11 +154,13 @@ void FixedStepper::try_step(const RigidState& s0, const ContactSet& c, double d,
     return;
   }
   slip_bias_ *= 0.25;
+  tilt_bias_ *= 0.25;
   if (try_step_with(s0, c, d, a, full, 0.25 * b)) {
     if (full) full_bias_ = 0.25 * b;
     return;
   }
   slip_bias_.setZero();
+  tilt_bias_.setZero();
   try_step_with(s0, c, d, a, full, 0.0);
   a.rise_dropped = true;
 }
@@ -115,7 +174,7 @@ bool FixedStepper::try_step_with(const RigidState& s0, const ContactSet& c, doub
   a.next.n = 0;
   a.capped = a.clamped = false;
   a.slip_vertex = -1;
-  a.risen = bias != 0.0 || !slip_bias_.isZero();  // (fixed steps: bias >= 0, no slip)
+  a.risen = bias != 0.0 || !slip_bias_.isZero() || !tilt_bias_.isZero();  // (fixed steps: bias >= 0, no slip)
   a.rise_dropped = false;
   if (leapfrog()) {
     try_step_dkd(s0, c, d, a, full, bias);
@@ -215,9 +274,11 @@ void FixedStepper::try_step_dkd(const RigidState& s0, const ContactSet& c, doubl
     s.velocity.z() -= kick_g_ * d;
     s.velocity.z() -= bias;
     s.velocity.head<2>() -= slip_bias_;
+    s.omega -= tilt_bias_;
     a.sup = apply_friction_impact(m, s, c, /*restitution=*/false, &warm_, &a.next);
     s.velocity.z() += bias;
     s.velocity.head<2>() += slip_bias_;
+    s.omega += tilt_bias_;
     const Vec3 L = world_inertia(m, s.R) * s.omega;  // the solve's angular momentum, kept by the second half
     if (full) {
       full_p_ = s0.position;
