@@ -10,6 +10,12 @@
 # utime + stime from /proc/PID/stat over SECONDS, as a share of one core; the events one client
 # received in that window give the update rate. Then the same without clients, for comparison.
 set -euo pipefail
+bad() { sed -n '5,6p' "$0" | sed 's/^#  *//' >&2; echo "$(basename "$0"): $1" >&2; exit 2; }
+[ -x "$(dirname "$0")/../${1:-build}/apps/dicesim" ] || [ -x "${1:-build}/apps/dicesim" ] ||
+  bad "no apps/dicesim in BUILD_DIR '${1:-build}' (a build directory, relative to the repository)"
+[[ ${2:-10} =~ ^[1-9][0-9]*$ ]] || bad "CLIENTS must be a positive integer, not '${2}'"
+[[ ${3:-20} =~ ^[1-9][0-9]*$ ]] || bad "SECONDS must be a positive integer, not '${3}'"
+[[ ${4:-curl} =~ ^(curl|chromium)$ ]] || bad "the client kind must be curl or chromium, not '${4}'"
 . "$(dirname "$0")/private_net.sh" "$@"
 export LCM_DEFAULT_URL="udpm://239.255.76.67:7667?ttl=0"
 cd "$(dirname "$0")/.."
