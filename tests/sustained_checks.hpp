@@ -348,6 +348,7 @@ inline double rocking_coin(const SustainedFactory& make, double tilt, double dur
 struct SpinResult {
   bool captured = false;  // the rest rule read `edge` (the side, face 2) before it fell
   double spin = 0.0;      // |w_z| at the fall or the capture (rad/s)
+  double spin_4s = 0.0;   // |w_z| at the first step's end at or after t = 4 s, still upright (0: fallen before)
   double t = 0.0;
   long steps = 0;
 };
@@ -360,6 +361,7 @@ inline SpinResult spinning_upright(const SustainedFactory& make, double spin = 3
   while (res.t < max_time) {
     res.t += step(s);
     ++res.steps;
+    if (res.spin_4s == 0.0 && res.t >= 4.0) res.spin_4s = std::abs(s.omega.z());
     const int f = rest_face_down(m, s, 0.5, kinetic_energy(m, s));
     if (f >= 0 || std::abs((s.R * m.rims.axis).z()) > 0.5) {
       res.captured = f == 2;
