@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/QR>
+
 #include "sim/dynamics/friction_impact.hpp"
 
 namespace dicesim {
@@ -80,8 +82,9 @@ LeapfrogBias leapfrog_bias(const DieModel& m, const RigidState& s0, const Contac
       W = Vec3(s * e.y(), -s * e.x(), 0.0);  // (W x e)_z = W_x e_y - W_y e_x
     }
   } else {
-    Eigen::Matrix<double, Eigen::Dynamic, 3> A(c.n, 3);
-    Eigen::VectorXd b(c.n);
+    // Dynamic sizes with fixed maxima: on the stack, no allocation in a toss.
+    Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxContacts, 3> A(c.n, 3);
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxContacts, 1> b(c.n);
     for (int i = 0; i < c.n; ++i) {
       A(i, 0) = 1.0;
       A(i, 1) = rm[i].y() / m.bounding_radius;
