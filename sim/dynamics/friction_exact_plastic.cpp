@@ -209,7 +209,11 @@ bool solve_sliding(const Body& b, const Points& pts, double speed, double lever,
       if (active[i]) idx[k++] = i;
     if (k == 0) return false;
     bool converged = false;
+    // (Zeroed: the first iteration reads prev_next times a gamma of 0. Finite stack garbage gave
+    // what zero gives; a NaN or an infinity there took the non-finite branch, d[j] = next[j] not
+    // renormalised, so the solve could depend on what ran before in the thread. Valgrind found it.)
     Eigen::Vector2d prev_r[kMaxN], prev_next[kMaxN];
+    for (int i = 0; i < kMaxN; ++i) prev_r[i] = prev_next[i] = Eigen::Vector2d::Zero();
     for (int it = 0; it < kMaxIterations && !converged; ++it) {
       for (int a = 0; a < k; ++a) {
         const int i = idx[a];
