@@ -140,7 +140,9 @@ double FixedStepper::predicted_miss(const ContactSet& c, const Vec3& r) {
   // arriving corner's lever at the step's start.
   const DieModel& m = *m_;
   const int k = c.n;
-  if (m.curved() || k == 0 || k > 4 || a_.next.n != k) return 0.0;
+  // (geo_ is the start's set-up: a fixed step's solve fills it, a leapfrog step's middle solve does not, so
+  // a leapfrog step without an impact at its start has none: the plain model then.)
+  if (m.curved() || k == 0 || k > 4 || a_.next.n != k || !geo_.valid) return 0.0;
   const double g = m.gravity;
   // The solve sees the pre-solve normal velocity shifted by the kick g d and the held corners'
   // rise b(d) (try_step): per unit step length g + b'. With no depth at the start b is linear in
