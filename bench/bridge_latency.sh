@@ -8,7 +8,8 @@
 #    subscriber; latency = receipt wall clock - the answer's utime (same host, same clock).
 set -euo pipefail
 bad() { sed -n '4p' "$0" | sed 's/^#  *//' >&2; echo "$(basename "$0"): $1" >&2; exit 2; }
-[ -x "$(dirname "$0")/../${1:-build}/apps/dicesim" ] || [ -x "${1:-build}/apps/dicesim" ] ||
+# (As the script uses it below: from the repository's root; an absolute path as it is.)
+(cd "$(dirname "$0")/.." && [ -x "${1:-build}/apps/dicesim" ]) ||
   bad "no apps/dicesim in BUILD_DIR '${1:-build}' (a build directory, relative to the repository)"
 [[ ${2:-2000} =~ ^[1-9][0-9]*$ ]] || bad "SAMPLES must be a positive integer, not '${2}'"
 . "$(dirname "$0")/private_net.sh" "$@"

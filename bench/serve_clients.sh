@@ -11,7 +11,8 @@
 # received in that window give the update rate. Then the same without clients, for comparison.
 set -euo pipefail
 bad() { sed -n '5,6p' "$0" | sed 's/^#  *//' >&2; echo "$(basename "$0"): $1" >&2; exit 2; }
-[ -x "$(dirname "$0")/../${1:-build}/apps/dicesim" ] || [ -x "${1:-build}/apps/dicesim" ] ||
+# (As the script uses it below: from the repository's root; an absolute path as it is.)
+(cd "$(dirname "$0")/.." && [ -x "${1:-build}/apps/dicesim" ]) ||
   bad "no apps/dicesim in BUILD_DIR '${1:-build}' (a build directory, relative to the repository)"
 [[ ${2:-10} =~ ^[1-9][0-9]*$ ]] || bad "CLIENTS must be a positive integer, not '${2}'"
 [[ ${3:-20} =~ ^[1-9][0-9]*$ ]] || bad "SECONDS must be a positive integer, not '${3}'"
