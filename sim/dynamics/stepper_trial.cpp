@@ -72,7 +72,6 @@ LeapfrogBias leapfrog_bias(const DieModel& m, const RigidState& s0, const Contac
   }
   // The asks as b0 + (W x r_i)_z: along an edge W is normal to it; on a face, least squares (exact:
   // depth, acceleration and velocity are affine across a rigid face).
-  double b0;
   Vec3 W = Vec3::Zero();
   if (c.n == 2) {
     const Vec3 e = rm[1] - rm[0];
@@ -95,7 +94,7 @@ LeapfrogBias leapfrog_bias(const DieModel& m, const RigidState& s0, const Contac
     W = Vec3(x(1) / m.bounding_radius, x(2) / m.bounding_radius, 0.0);
   }
   // The rise at the COM: every corner at least its ask.
-  b0 = -std::numeric_limits<double>::infinity();
+  double b0 = -std::numeric_limits<double>::infinity();
   double rz = 0.0;
   for (int i = 0; i < c.n; ++i) {
     b0 = std::max(b0, ask[i] - W.cross(rm[i]).z());
