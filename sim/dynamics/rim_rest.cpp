@@ -90,7 +90,15 @@ int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, 
   if (!above_barriers) {
     const double energy = ke + mg * (s.position.z() + std::max(0.0, -low));
     const int basin = rim_quasi_static_down(m, s.R, tiebreak);
-    if (basin >= 0 && energy < mg * m.face_escape[static_cast<std::size_t>(basin)] * (1.0 - 1e-9)) return basin;
+    if (basin >= 0 && energy < mg * m.face_escape[static_cast<std::size_t>(basin)] * (1.0 - 1e-9)) {
+      // On the side, the barrier out of the basin is small for a thin coin (tens of um of lift):
+      // a coin below it may still spin upright or roll for a second. It cannot fall, but it is
+      // named `edge` only once it has stopped (every point slower than v_tol), so no answer is
+      // read from a coin that is still moving.
+      if (basin != 2) return basin;
+      const double v_tol = 1e-3 * std::sqrt(m.gravity * m.bounding_radius);
+      return s.velocity.norm() + s.omega.norm() * m.bounding_radius <= v_tol ? basin : -1;
+    }
   }
 
   // Lying flat on a face, sliding or spinning but not rocking (as a polytope's face, rest.hpp, and
