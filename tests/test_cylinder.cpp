@@ -898,6 +898,44 @@ TEST(CylinderImpulse, UprightSpinningQuarterFallsAsItSlows) {
   }
 }
 
+// A coin standing on its band, tilted 1 deg, no spin, rocks from rim to rim. Each arrival on the
+// other rim is a plastic impact that keeps the angular momentum about that rim (Housner 1963, the
+// rocking block): the angular velocity's ratio r = (I_d + m(c^2 - b^2)) / (I_d + m(c^2 + b^2)), with
+// I_d the moment about a diameter, c the COM's height over the rims and b their half-spacing; the
+// energy keeps r^2 (0.98309 for the nickel). Measured 0.98312-0.98319 at every crossing from the
+// third to the eighth, 0.2 ms steps.
+TEST(CylinderImpulse, RockingCoinKeepsHousnersShareAtEachArrival) {
+  const DieModel m = compile(ready_coin(
+      "quarter-table.toml", {"die.radius=0.010605", "die.height=0.00195", "materials.clad.density=7258"}));
+  const double b = m.rims.half, c = m.face_height[2];
+  const Vec3 d = m.rims.axis.unitOrthogonal();
+  const double Id = d.dot(m.principal_moments.cwiseProduct(d)) / m.mass;
+  const double r = (Id + c * c - b * b) / (Id + c * c + b * b);
+  RigidState s;
+  const double tilt = 1.0 * kPi / 180.0;
+  s.R = Quat::FromTwoVectors(m.rims.axis, Vec3(std::cos(tilt), 0.0, std::sin(tilt))).toRotationMatrix();
+  s.position = Vec3(0.0, 0.0, -rim_lowest(m, s.R));
+  auto lift = [&](const RigidState& q) {  // held energy above the coin lying on its band (m)
+    const double low = q.position.z() + rim_lowest(m, q.R);
+    return kinetic_energy(m, q) / (m.mass * m.gravity) + q.position.z() + std::max(0.0, -low) - c;
+  };
+  FixedStepper st(m, m.contact_step, ImpactThreshold::Gravity, held_corner_sink(m));
+  int side = 1, crossings = 0;
+  double last = 0.0;
+  for (int k = 0; k < 20000 && crossings < 8; ++k) {
+    st.step(s);
+    const int now = (s.R * m.rims.axis).z() > 0.0 ? 1 : -1;
+    if (now == side) continue;
+    side = now;
+    const double e = lift(s);
+    if (++crossings >= 3) {
+      EXPECT_NEAR(e / last, r * r, 2e-4) << "crossing " << crossings;
+    }
+    last = e;
+  }
+  EXPECT_EQ(crossings, 8);
+}
+
 TEST(CylinderImpulse, EdgeGrowsWithThickness) {
   SoftTable soft;
   double last = -1.0;
