@@ -250,8 +250,10 @@ int census_spun(const DieModel& m, double tilt_deg, const std::vector<double>& s
     int impacts = 0;
     const StepperOutcome o =
         run_fixed_steps(m, s, t, impacts, m.contact_step, 0.3, /*allow_liftoff=*/true, ImpactThreshold::Gravity, nullptr);
-    std::printf("  %6.1f rad/s: %s after %.2f s\n", w,
-                o.exit == StepperExit::Settled && o.face_down >= 0 ? names[o.face_down] : "unresolved", t);
+    const char* end = o.exit == StepperExit::LiftOff ? "lifted off the table (not followed)"
+                      : o.exit == StepperExit::Settled && o.face_down >= 0 ? names[o.face_down]
+                                                                            : "unresolved";
+    std::printf("  %6.1f rad/s: %s after %.2f s\n", w, end, t);
   }
   return 0;
 }
