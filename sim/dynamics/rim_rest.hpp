@@ -9,8 +9,9 @@
 // d.k = 0 (stable when |o.k| < b); the saddles between them are the die balanced on a rim point
 // with the COM above it, at the distance from the COM to the nearest point of that rim circle.
 // No impact or contact solve creates energy, so E < m g (that saddle's height) in a basin means
-// the die ends in that basin: an edge-rolling cylinder is settled `edge` as soon as it can no
-// longer tip onto a face, without following its roll to a stop.
+// the die ends in that basin. A face's basin is read at once; on its side the cylinder is also
+// followed until it has stopped, so that `edge` is never read from a coin still rolling or
+// spinning upright (a thin coin's side barrier is tens of um of lift).
 #pragma once
 
 #include "sim/body/die_model.hpp"
@@ -27,7 +28,8 @@ void compute_rim_rest_geometry(DieModel& m);
 // rim balance decides). Returns the face down (0, 1, 2) or -1 if the step guard ran out.
 int rim_quasi_static_down(const DieModel& m, const Mat3& R, double tiebreak);
 
-// The face the die must come to rest on (energy below its basin's saddle), or -1; ke =
+// The face the die must come to rest on (energy below its basin's saddle; on the side, also
+// stopped: every point slower than 1e-3 sqrt(g r)), or -1; ke =
 // kinetic_energy(m, s) (contact.hpp). (rest_face_down dispatches here for a curved die.)
 int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, double ke);
 
