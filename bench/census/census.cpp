@@ -90,7 +90,7 @@ TossResult run_toss(const DieModel& m, std::uint64_t seed, std::uint64_t i, F f)
 // --- edge ------------------------------------------------------------------------------------
 
 struct Snap {
-  double t = 0, excess = 0, vh = 0, vz = 0, w_roll = 0, w_z = 0;
+  double t = 0, excess = 0, vh = 0, w_roll = 0, w_z = 0;
   int via = kStep;
 };
 
@@ -110,21 +110,23 @@ int census_edge(const DieModel& m, std::uint64_t seed, std::uint64_t first, std:
     double t_last = 0;
     const TossResult r = run_toss(m, seed, i, [&](double t, const RigidState& s, int via) {
       const bool side = rim_quasi_static_down(m, s.R, 0.5) == 2;
-      if (side && !in) {
+      t_last = t;
+      if (!side) {
+        in = false;
+        return;
+      }
+      const double excess = lift_energy(m, s) - m.face_escape[2];
+      const Vec3 K = s.R * m.rims.axis;
+      const Snap now{t, excess, std::hypot(s.velocity.x(), s.velocity.y()), s.omega.dot(K), s.omega.z(), via};
+      if (!in) {
         in = true;
         have_below = false;
-        const Vec3 K = s.R * m.rims.axis;
-        entry = {t, lift_energy(m, s) - m.face_escape[2], std::hypot(s.velocity.x(), s.velocity.y()), s.velocity.z(),
-                 s.omega.dot(K), s.omega.z(), via};
-      } else if (!side) {
-        in = false;
+        entry = now;
       }
-      if (in && !have_below && lift_energy(m, s) < m.face_escape[2]) {
-        const Vec3 K = s.R * m.rims.axis;
-        below = {t, 0.0, std::hypot(s.velocity.x(), s.velocity.y()), s.velocity.z(), s.omega.dot(K), s.omega.z(), via};
+      if (!have_below && excess < 0.0) {
+        below = now;
         have_below = true;
       }
-      t_last = t;
     });
     if (r.status != TossStatus::Settled) continue;
     ++settled;

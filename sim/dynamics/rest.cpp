@@ -255,7 +255,7 @@ int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, doub
       }
     }
     const std::size_t di = static_cast<std::size_t>(down);
-    const double v_tol = 1e-3 * std::sqrt(m.gravity * m.bounding_radius);
+    const double v_tol = rest_speed_tol(m);
     // The largest spin the flat motion can ever reach: all of its kinetic energy (friction only
     // removes it) in the spin about the face's normal n, w^2 <= 2 ke / (n . I n).
     const Vec3& n = m.face_normals[di];

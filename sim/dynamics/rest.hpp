@@ -9,6 +9,8 @@
 // with the die in A's basin, it can never leave: it comes to rest on A, whatever it does next.
 #pragma once
 
+#include <cmath>
+
 #include "sim/body/die_model.hpp"
 #include "sim/dynamics/flight.hpp"
 
@@ -63,6 +65,10 @@ int roll_from_face(const DieModel& m, int f, double tiebreak);
 int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak);
 // The same given ke = kinetic_energy(m, s) (contact.hpp), for a caller that has it already.
 int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, double ke);
+
+// The speed below which the rest rules count a corner (or, on a cylinder's side, the whole die) as
+// still: 1e-3 sqrt(g r), r the bounding radius.
+inline double rest_speed_tol(const DieModel& m) { return 1e-3 * std::sqrt(m.gravity * m.bounding_radius); }
 
 // The face that is read when face f lies on the floor (the face up, or f for a die read down).
 inline int result_face(const DieModel& m, int f) { return m.face_result[static_cast<std::size_t>(f)]; }

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "sim/dynamics/contact.hpp"
+#include "sim/dynamics/rest.hpp"
 #include "sim/sincos.hpp"
 
 namespace dicesim {
@@ -96,8 +97,7 @@ int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, 
       // named `edge` only once it has stopped (every point slower than v_tol), so no answer is
       // read from a coin that is still moving.
       if (basin != 2) return basin;
-      const double v_tol = 1e-3 * std::sqrt(m.gravity * m.bounding_radius);
-      return s.velocity.norm() + s.omega.norm() * m.bounding_radius <= v_tol ? basin : -1;
+      return s.velocity.norm() + s.omega.norm() * m.bounding_radius <= rest_speed_tol(m) ? basin : -1;
     }
   }
 
@@ -111,7 +111,7 @@ int rim_rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, 
   const int down = kz < 0.0 ? 0 : 1;  // face 0 (heads face) down when the axis points down
   const std::size_t di = static_cast<std::size_t>(down);
   const double flat_tol = 1e-6 * m.bounding_radius;
-  const double v_tol = 1e-3 * std::sqrt(m.gravity * m.bounding_radius);
+  const double v_tol = rest_speed_tol(m);
   const Vec3& n = m.rims.axis;  // body frame: the face normals are +-axis
   const double spin_max2 = 2.0 * ke / n.dot(m.principal_moments.cwiseProduct(n));
   if (!(m.face_hold[di] > 0.0 &&
