@@ -107,7 +107,7 @@ TEST(CliFirstHour, TradeoffStepsTakeCommasAndSayWhatIsAccepted) {
 TEST(CliFirstHour, ACoinsSweepTableNamesItsSides) {
   const CliRun coin = cli("sweep scenes/coins/three-sided.toml -n 50 --fidelity static");
   ASSERT_EQ(coin.code, 0) << coin.err;
-  EXPECT_NE(coin.out.find(" P(edge)  P(heads)  P(tails)   unresolved  invalid\n0.1              0.1400    0.4400"),
+  EXPECT_NE(coin.out.find(" P(edge)  P(heads)  P(tails)   unresolved  invalid\n0.05             0.0600    0.5000"),
             std::string::npos)
       << coin.out;
   EXPECT_EQ(coin.out.find("P(0)"), std::string::npos) << coin.out;
