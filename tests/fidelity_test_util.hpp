@@ -50,6 +50,13 @@ inline SceneDef at_rest(SceneDef s, const Vec3& euler_deg) {
   return s;
 }
 
+// Toss `index` of a run with `seed`, leaving its final state in `end` (where it settled).
+inline TossResult toss_to_end(const DieModel& m, std::uint64_t seed, std::uint64_t index, RigidState& end) {
+  TossProbe probe;
+  probe.final_state = &end;
+  return toss(m, seed, index, &probe);
+}
+
 inline RunCounts run(const DieModel& m, std::uint64_t n, std::uint64_t seed = 1, int threads = 2) {
   RunConfig cfg;
   cfg.seed = seed;
@@ -113,9 +120,7 @@ RestSoundness check_rest_is_sound(const DieModel& m, std::uint64_t seed, int n, 
   RestSoundness out;
   for (int i = 0; i < n; ++i) {
     RigidState s;
-    TossProbe probe;
-    probe.final_state = &s;
-    const TossResult r = toss(m, seed, static_cast<std::uint64_t>(i), &probe);
+    const TossResult r = toss_to_end(m, seed, static_cast<std::uint64_t>(i), s);
     if (r.status != TossStatus::Settled) continue;
     ++out.settled;
     const int down = rest_face_down(m, s, 0.5);

@@ -1180,9 +1180,7 @@ TEST(CylinderImpulse, EdgeIsNamedOnlyForAStoppedCoinThatCannotFall) {
   int edges = 0;
   for (int i = 0; i < 1000; ++i) {
     RigidState s;
-    TossProbe probe;
-    probe.final_state = &s;
-    const TossResult r = toss(m, 11, static_cast<std::uint64_t>(i), &probe);
+    const TossResult r = dicesim::testing::toss_to_end(m, 11, static_cast<std::uint64_t>(i), s);
     ASSERT_EQ(r.status, TossStatus::Settled) << i;
     if (r.face_index != 2) continue;
     ++edges;

@@ -1,8 +1,9 @@
-// Rest soundness for any convex die: when `impulse` says "settled", the die really is at rest on
-// that face. Continued with the contact stepper for 0.5 s (plastic contact with friction, the
-// `stepped` physics), the face on the floor never changes. 10^3 tosses per die: fair d4, d8, d20,
-// a long triangular prism, an irregular hull, a rounded d20, a loaded d20, and the irregular hull
-// thrown with a fast spin (its face normals are not principal axes: the gyroscopic term).
+// Rest soundness for any convex die: when `impulse` says "settled", the die really comes to rest
+// on a face read as that one. Continued with the contact stepper for 0.5 s (plastic contact with
+// friction, the `stepped` physics), the face on the floor never changes to one read otherwise.
+// 10^3 tosses per die: fair d4, d8, d20, a long triangular prism, an irregular hull, a rounded d20,
+// a loaded d20, and the irregular hull thrown with a fast spin (its face normals are not principal
+// axes: the gyroscopic term).
 #include <gtest/gtest.h>
 
 #include <string>
@@ -47,9 +48,7 @@ void check_rest_soundness(const Case& c, int tosses) {
   int settled = 0, unresolved = 0;
   for (int i = 0; i < tosses; ++i) {
     RigidState s;
-    TossProbe probe;
-    probe.final_state = &s;
-    const TossResult r = toss(m, 31, static_cast<std::uint64_t>(i), &probe);
+    const TossResult r = toss_to_end(m, 31, static_cast<std::uint64_t>(i), s);
     if (r.status != TossStatus::Settled) {
       ++unresolved;
       continue;
@@ -60,9 +59,12 @@ void check_rest_soundness(const Case& c, int tosses) {
     ASSERT_GE(down, 0) << c.name << " toss " << i;
     ASSERT_EQ(result_face(m, down), r.face_index) << c.name << " toss " << i;
     ASSERT_GE(m.face_hold[static_cast<std::size_t>(down)], 0.0) << c.name << ": a face that cannot hold the COM";
-    // 0.5 s more of contact dynamics: the face on the floor at the end is that face, and the
-    // rest criterion never names another face on the way. (The die need not lie flat all along: it
-    // may still roll onto the face, or a d4 wobble on its corners as a spinning coin does.)
+    // 0.5 s more of contact dynamics: the face on the floor at the end reads as that face, and the
+    // rest criterion never names a face read otherwise on the way. (The die need not lie flat all
+    // along: it may still roll onto the face, or a d4 wobble on its corners as a spinning coin does;
+    // and settled means its outcome can no longer change, so it may still cross to a neighbouring
+    // face that reads the same, as the irregular hull's faces under one face up do: rest.hpp.)
+    auto outcome = [&](int f) { return m.face_outcome[static_cast<std::size_t>(result_face(m, f))]; };
     FixedStepper st(m, 5e-4);
     for (int k = 1; k <= 1000; ++k) {
       st.step(s);
@@ -70,12 +72,12 @@ void check_rest_soundness(const Case& c, int tosses) {
       // -1 is allowed: a die that was called flat while still sliding fast has more energy than
       // the barrier, and while it wobbles only the friction argument (not checked again) holds.
       const int again = rest_face_down(m, s, 0.5);
-      ASSERT_TRUE(again == down || again == -1) << c.name << " toss " << i << " after " << k * 5e-4 << " s: " << again;
+      ASSERT_TRUE(again == -1 || outcome(again) == outcome(down)) << c.name << " toss " << i << " after " << k * 5e-4 << " s: " << again;
     }
-    // The face on the floor at the end is that face. It need not lie flat yet: with restitution in
-    // every step (the energy-safe stepper) a die may still rock on that face after 0.5 s.
+    // The face on the floor at the end reads as that face. It need not lie flat yet: with
+    // restitution in every step (the energy-safe stepper) a die may still rock on it after 0.5 s.
     double highest = 0.0;
-    EXPECT_EQ(face_down(m, s, highest), down) << c.name << " toss " << i;
+    EXPECT_EQ(outcome(face_down(m, s, highest)), outcome(down)) << c.name << " toss " << i;
   }
   // Unresolved tosses are counted, not checked here; the irregular hull has ~0.6% (it hits the
   // impact cap: see the report of issue 11), the regular solids none.

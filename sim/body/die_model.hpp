@@ -87,9 +87,12 @@ struct DieModel {
   std::vector<double> face_height;     // COM height resting on the face
   std::vector<double> face_hold;       // min distance from the COM's foot to the face's edges (< 0: cannot hold it)
   std::vector<double> face_escape;     // lowest pass out of the face's basin (COM height; +inf: no way out)
+  // lowest pass out of the region of basins read as the face's outcome, to a basin read as another
+  // (COM height; +inf: none): below it the outcome can no longer change (rest.hpp)
+  std::vector<double> outcome_escape;
   std::vector<double> face_tip_ratio;  // face_hold / face_height: the friction coefficient that tips it
   std::vector<double> face_gyro;       // |n x I n|: spinning at w about the normal needs a torque w^2 |n x I n|
-  double max_escape = 0.0;             // max of the finite face_escape
+  double max_escape = 0.0;             // max of the finite outcome_escape
   double max_friction = 0.0;           // max of vertex_friction
 
   // Simulation settings, copied from the scene.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "sim/dynamics/contact.hpp"
 #include "sim/dynamics/rim_rest.hpp"
@@ -123,7 +124,98 @@ int roll_face(const DieModel& m, int f, double tiebreak, int& guard) {
   return -1;
 }
 
+// A saddle between two different basins: the die balanced on an edge with its COM straight above
+// it, at COM height `height`, the two sides rolling to basins a and b.
+struct Saddle {
+  int a, b;
+  double height;
+};
+
+// Every edge once (from the face whose loop has it, to the face across).
+std::vector<Saddle> basin_saddles(const DieModel& m) {
+  const int nf = m.face_count();
+  std::vector<int> basin(static_cast<std::size_t>(nf));
+  for (int f = 0; f < nf; ++f) {
+    int guard = roll_guard(m);
+    basin[static_cast<std::size_t>(f)] = roll_face(m, f, 0.5, guard);
+  }
+  std::vector<Saddle> out;
+  for (int f = 0; f < nf; ++f) {
+    const auto loop = m.face_vertices(f);
+    const int k = static_cast<int>(loop.size());
+    for (int i = 0; i < k; ++i) {
+      const int g = m.face_across[static_cast<std::size_t>(m.face_begin[static_cast<std::size_t>(f)] + i)];
+      if (g < f) continue;
+      const Vec3& A = m.vertices[static_cast<std::size_t>(loop[static_cast<std::size_t>(i)])];
+      const Vec3& B = m.vertices[static_cast<std::size_t>(loop[static_cast<std::size_t>((i + 1) % k)])];
+      const Vec3 ab = B - A;
+      const double t = (-A).dot(ab) / ab.squaredNorm();
+      if (t < 0.0 || t > 1.0) continue;  // the COM projects beyond the edge: no balance on it
+      const Vec3 w = -(A + t * ab);       // from the edge to the COM
+      // Balanced on the edge, the floor's normal -w/|w| must lie between the two face normals:
+      // -w = a n_f + b n_g with a, b >= 0 (all three are perpendicular to the edge).
+      const Vec3& nf_ = m.face_normals[static_cast<std::size_t>(f)];
+      const Vec3& ng = m.face_normals[static_cast<std::size_t>(g)];
+      const double c = nf_.dot(ng), d1 = -w.dot(nf_), d2 = -w.dot(ng);
+      const double det = 1.0 - c * c;
+      if (det <= 0.0) continue;
+      const double a = (d1 - c * d2) / det, b = (d2 - c * d1) / det;
+      const double tol = -1e-12 * w.norm();
+      if (a < tol || b < tol) continue;
+      const int bf = basin[static_cast<std::size_t>(f)], bg = basin[static_cast<std::size_t>(g)];
+      if (bf == bg || bf < 0 || bg < 0) continue;
+      out.push_back({bf, bg, w.norm() + m.rounding});
+    }
+  }
+  return out;
+}
+
 }  // namespace
+
+void compute_outcome_escape(DieModel& m) {
+  const std::size_t F = static_cast<std::size_t>(m.face_count());
+  m.outcome_escape = m.face_escape;
+  if (!m.curved()) {
+    const std::vector<Saddle> saddles = basin_saddles(m);
+    auto outcome = [&](int f) { return m.face_outcome[static_cast<std::size_t>(m.face_result[static_cast<std::size_t>(f)])]; };
+    // Per basin A: the least, over paths of saddles, of the highest saddle on the path (a minimax
+    // Dijkstra over the few basins), to every basin; the least of it over the basins read otherwise.
+    std::vector<double> pass(F);
+    std::vector<char> done(F);
+    for (std::size_t a = 0; a < F; ++a) {
+      if (!std::isfinite(m.face_escape[a])) continue;  // not a basin with a way out
+      std::fill(pass.begin(), pass.end(), kInf);
+      std::fill(done.begin(), done.end(), 0);
+      pass[a] = -kInf;
+      double out = kInf;
+      for (;;) {
+        std::size_t u = F;
+        for (std::size_t v = 0; v < F; ++v)
+          if (!done[v] && pass[v] < kInf && (u == F || pass[v] < pass[u])) u = v;
+        if (u == F || pass[u] >= out) break;
+        done[u] = 1;
+        if (outcome(static_cast<int>(u)) != outcome(static_cast<int>(a))) {
+          out = std::min(out, pass[u]);
+          continue;
+        }
+        for (const Saddle& sd : saddles) {
+          const std::size_t x = static_cast<std::size_t>(sd.a), y = static_cast<std::size_t>(sd.b);
+          const std::size_t v = x == u ? y : y == u ? x : F;
+          if (v < F && !done[v]) pass[v] = std::min(pass[v], std::max(pass[u], sd.height));
+        }
+      }
+      m.outcome_escape[a] = out;
+    }
+  }
+  m.max_escape = 0.0;
+  bool any_finite = false;
+  for (std::size_t f = 0; f < F; ++f)
+    if (std::isfinite(m.outcome_escape[f]) && (!m.curved() || m.face_hold[f] >= 0.0)) {
+      m.max_escape = std::max(m.max_escape, m.outcome_escape[f]);
+      any_finite = true;
+    }
+  if (!any_finite) m.max_escape = kInf;  // one outcome only: every toss ends on it
+}
 
 void compute_rest_geometry(DieModel& m) {
   const int nf = m.face_count();
@@ -158,49 +250,10 @@ void compute_rest_geometry(DieModel& m) {
     m.face_area[fi] = 0.5 * std::abs(area2.dot(n));
   }
 
-  // Saddles: every edge once (from the face whose loop has it, to the face across).
-  std::vector<int> basin(F);
-  for (int f = 0; f < nf; ++f) {
-    int guard = roll_guard(m);
-    basin[static_cast<std::size_t>(f)] = roll_face(m, f, 0.5, guard);
+  for (const Saddle& sd : basin_saddles(m)) {
+    m.face_escape[static_cast<std::size_t>(sd.a)] = std::min(m.face_escape[static_cast<std::size_t>(sd.a)], sd.height);
+    m.face_escape[static_cast<std::size_t>(sd.b)] = std::min(m.face_escape[static_cast<std::size_t>(sd.b)], sd.height);
   }
-  for (int f = 0; f < nf; ++f) {
-    const auto loop = m.face_vertices(f);
-    const int k = static_cast<int>(loop.size());
-    for (int i = 0; i < k; ++i) {
-      const int g = m.face_across[static_cast<std::size_t>(m.face_begin[static_cast<std::size_t>(f)] + i)];
-      if (g < f) continue;
-      const Vec3& A = m.vertices[static_cast<std::size_t>(loop[static_cast<std::size_t>(i)])];
-      const Vec3& B = m.vertices[static_cast<std::size_t>(loop[static_cast<std::size_t>((i + 1) % k)])];
-      const Vec3 ab = B - A;
-      const double t = (-A).dot(ab) / ab.squaredNorm();
-      if (t < 0.0 || t > 1.0) continue;  // the COM projects beyond the edge: no balance on it
-      const Vec3 w = -(A + t * ab);       // from the edge to the COM
-      // Balanced on the edge, the floor's normal -w/|w| must lie between the two face normals:
-      // -w = a n_f + b n_g with a, b >= 0 (all three are perpendicular to the edge).
-      const Vec3& nf_ = m.face_normals[static_cast<std::size_t>(f)];
-      const Vec3& ng = m.face_normals[static_cast<std::size_t>(g)];
-      const double c = nf_.dot(ng), d1 = -w.dot(nf_), d2 = -w.dot(ng);
-      const double det = 1.0 - c * c;
-      if (det <= 0.0) continue;
-      const double a = (d1 - c * d2) / det, b = (d2 - c * d1) / det;
-      const double tol = -1e-12 * w.norm();
-      if (a < tol || b < tol) continue;
-      const int bf = basin[static_cast<std::size_t>(f)], bg = basin[static_cast<std::size_t>(g)];
-      if (bf == bg || bf < 0 || bg < 0) continue;
-      const double height = w.norm() + m.rounding;
-      m.face_escape[static_cast<std::size_t>(bf)] = std::min(m.face_escape[static_cast<std::size_t>(bf)], height);
-      m.face_escape[static_cast<std::size_t>(bg)] = std::min(m.face_escape[static_cast<std::size_t>(bg)], height);
-    }
-  }
-  m.max_escape = 0.0;
-  bool any_finite = false;
-  for (double e : m.face_escape)
-    if (std::isfinite(e)) {
-      m.max_escape = std::max(m.max_escape, e);
-      any_finite = true;
-    }
-  if (!any_finite) m.max_escape = kInf;  // one basin only: every toss ends on it
 }
 
 int quasi_static_down_face(const DieModel& m, const Mat3& R, double tiebreak) {
@@ -278,7 +331,7 @@ int rest_face_down(const DieModel& m, const RigidState& s, double tiebreak, doub
   if (above_barriers) return -1;
   const double energy = ke + mg * (s.position.z() + std::max(0.0, -low));
   const int basin = quasi_static_down_face(m, s.R, tiebreak);
-  if (basin >= 0 && energy < mg * m.face_escape[static_cast<std::size_t>(basin)] * (1.0 - 1e-9)) return basin;
+  if (basin >= 0 && energy < mg * m.outcome_escape[static_cast<std::size_t>(basin)] * (1.0 - 1e-9)) return basin;
   return -1;
 }
 

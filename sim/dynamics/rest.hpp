@@ -7,6 +7,8 @@
 // No impact of these models creates energy and friction only removes it, so once
 //   E = kinetic + m g (COM height + penetration)  <  m g face_escape[A]
 // with the die in A's basin, it can never leave: it comes to rest on A, whatever it does next.
+// What a toss reports is the outcome, so the rule uses the pass out of the basins that read as A's
+// outcome (outcome_escape, at least face_escape): below it the outcome is settled.
 #pragma once
 
 #include <cmath>
@@ -16,13 +18,23 @@
 
 namespace dicesim {
 
-// Fills the face_* fields and max_escape of a model whose vertices, faces (loops, normals,
-// across), adjacency, frictions, rounding and principal moments are set. The basin barrier
-// face_escape[B] is the lowest saddle on the boundary of B's basin: the die balanced on an edge
-// with its COM straight above it (a critical point of the COM height only where the COM projects
-// inside the edge and the vertical lies between the edge's two face normals), height = distance
-// from the COM to the edge + rounding, separating the basins the two sides roll to.
+// Fills the face_* fields of a model whose vertices, faces (loops, normals, across), adjacency,
+// frictions, rounding and principal moments are set. The basin barrier face_escape[B] is the lowest
+// saddle on the boundary of B's basin: the die balanced on an edge with its COM straight above it
+// (a critical point of the COM height only where the COM projects inside the edge and the vertical
+// lies between the edge's two face normals), height = distance from the COM to the edge + rounding,
+// separating the basins the two sides roll to.
 void compute_rest_geometry(DieModel& m);
+
+// Fills outcome_escape and max_escape once the faces' reads are final (compile calls it after
+// compute_rest_geometry and the read ties): outcome_escape[A] is the lowest pass out of the region
+// of basins that read as A's outcome, the least over paths of saddles from A's basin to a basin
+// read as another outcome of the highest saddle on the path. Below it the die can wander between
+// basins of its outcome (two triangles of one printed face, 1 degree apart, with a saddle 0.1 um
+// above them) but never reach another outcome, so the outcome is settled. Where every neighbouring
+// basin reads differently (every ready die but binom4) it equals face_escape. A cylinder's is its
+// face_escape.
+void compute_outcome_escape(DieModel& m);
 
 // Quasi-static roll from orientation R (body -> world) standing on its lowest corner: pivot about
 // that corner in the vertical plane through it and the COM until an edge touches (steepest
@@ -40,7 +52,8 @@ int quasi_static_down_face(const DieModel& m, const Mat3& R, double tiebreak);
 int roll_from_face(const DieModel& m, int f, double tiebreak);
 
 // The face (index) the die must come to rest on, or -1 while it is still undecided:
-//  - energy: E < m g face_escape[A] with A = the basin of R (above); or
+//  - energy: E < m g outcome_escape[A] with A = the basin of R (above): the die may still cross
+//    into a basin of A's outcome, never into another's, so A is read; or
 //  - lying flat: every corner of the face most nearly down, A, on the floor with vanishing normal
 //    velocity; every corner's friction below face_tip_ratio[A], so friction cannot tip it while it
 //    slides or spins; and the largest spin w about the vertical that the flat motion can ever
