@@ -104,6 +104,13 @@ void print_info(const std::string& path, const DieModel& m, const FloorDef& floo
     else
       std::printf(" %s\n", m.face_hold[f] >= 0.0 ? "none (the only basin)" : "-");
   }
+  // Where a neighbouring basin reads the same, the outcome settles below a higher pass (rest.hpp).
+  for (std::size_t f = 0; f < m.face_normals.size(); ++f)
+    if (m.outcome_escape[f] != m.face_escape[f])
+      std::printf("face %zu: a neighbouring basin also reads %d; the lowest pass to another outcome is %.6g m "
+                  "(a toss settles below it)\n",
+                  f, m.outcome_labels[static_cast<std::size_t>(m.face_outcome[static_cast<std::size_t>(m.face_result[f])])],
+                  m.outcome_escape[f]);
   print_outcome_map(m);
   // Where the two numbers come from: the materials at the corner, or the scene's [floor] values.
   auto source = [](const char* what, bool from_floor) {

@@ -17,13 +17,16 @@ namespace {
 nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 nlohmann::json mat(const Mat3& m) { return {vec(m.row(0)), vec(m.row(1)), vec(m.row(2))}; }
 
-// Resting geometry: per face, the COM height on it and the lowest pass out of its basin.
+// Resting geometry: per face, the COM height on it, the lowest pass out of its basin and the lowest
+// pass to a basin read otherwise (where the outcome settles).
 nlohmann::json rest_json(const DieModel& m) {
   nlohmann::json faces = nlohmann::json::array();
   for (std::size_t f = 0; f < m.face_normals.size(); ++f)
     faces.push_back({{"label", m.face_labels[f]},
                      {"height", m.face_height[f]},
                      {"escape_height", std::isfinite(m.face_escape[f]) ? nlohmann::json(m.face_escape[f]) : nlohmann::json()},
+                     {"outcome_escape_height",
+                      std::isfinite(m.outcome_escape[f]) ? nlohmann::json(m.outcome_escape[f]) : nlohmann::json()},
                      {"tip_ratio", m.face_tip_ratio[f]}});
   return faces;
 }

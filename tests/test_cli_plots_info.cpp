@@ -184,3 +184,15 @@ TEST(CliInfo, EachRegionHasItsVolumeAndMass) {
   EXPECT_TRUE(has(text.out, "region 0")) << text.out;
   EXPECT_TRUE(has(text.out, "volume (cm^3)")) << text.out;
 }
+
+// binom4's back face is two triangles that both read 3: `info` says that their outcome settles below
+// the pass to another outcome (rest.hpp), which the table's per-basin escape does not show; the
+// JSON carries both passes. A die whose basins all read differently prints no such line.
+TEST(CliInfo, BasinsReadTheSameShowTheirOutcomesPass) {
+  const CliRun r = cli("info scenes/dice/binom4.toml");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "face 5: a neighbouring basin also reads 3; the lowest pass to another outcome is 0.00792")) << r.out;
+  const auto j = nlohmann::json::parse(cli("info scenes/dice/binom4.toml --json").out);
+  EXPECT_GT(j["rest"][5]["outcome_escape_height"].get<double>(), j["rest"][5]["escape_height"].get<double>() + 1e-3);
+  EXPECT_FALSE(has(cli("info scenes/dice/binom3.toml").out, "a neighbouring basin also reads"));
+}
