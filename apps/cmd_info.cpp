@@ -109,7 +109,7 @@ void print_info(const std::string& path, const DieModel& m, const FloorDef& floo
     if (m.outcome_escape[f] != m.face_escape[f])
       std::printf("face %zu: a neighbouring basin also reads %d; the lowest pass to another outcome is %.6g m "
                   "(a toss settles below it)\n",
-                  f, m.outcome_labels[static_cast<std::size_t>(m.face_outcome[static_cast<std::size_t>(m.face_result[f])])],
+                  f, resting_outcome_label(m, static_cast<int>(f)),
                   m.outcome_escape[f]);
   print_outcome_map(m);
   // Where the two numbers come from: the materials at the corner, or the scene's [floor] values.

@@ -10,6 +10,7 @@
 
 #include "fidelity_test_util.hpp"
 #include "polytopes_for_tests.hpp"
+#include "sim/body/outcome.hpp"
 #include "sim/dynamics/contact_stepper.hpp"
 #include "sim/dynamics/rest.hpp"
 #include "sim/models/compile.hpp"
@@ -64,7 +65,6 @@ void check_rest_soundness(const Case& c, int tosses) {
     // along: it may still roll onto the face, or a d4 wobble on its corners as a spinning coin does;
     // and settled means its outcome can no longer change, so it may still cross to a neighbouring
     // face that reads the same, as the irregular hull's faces under one face up do: rest.hpp.)
-    auto outcome = [&](int f) { return m.face_outcome[static_cast<std::size_t>(result_face(m, f))]; };
     FixedStepper st(m, 5e-4);
     for (int k = 1; k <= 1000; ++k) {
       st.step(s);
@@ -72,12 +72,13 @@ void check_rest_soundness(const Case& c, int tosses) {
       // -1 is allowed: a die that was called flat while still sliding fast has more energy than
       // the barrier, and while it wobbles only the friction argument (not checked again) holds.
       const int again = rest_face_down(m, s, 0.5);
-      ASSERT_TRUE(again == -1 || outcome(again) == outcome(down)) << c.name << " toss " << i << " after " << k * 5e-4 << " s: " << again;
+      ASSERT_TRUE(again == -1 || resting_outcome_label(m, again) == resting_outcome_label(m, down))
+          << c.name << " toss " << i << " after " << k * 5e-4 << " s: " << again;
     }
     // The face on the floor at the end reads as that face. It need not lie flat yet: with
     // restitution in every step (the energy-safe stepper) a die may still rock on it after 0.5 s.
     double highest = 0.0;
-    EXPECT_EQ(outcome(face_down(m, s, highest)), outcome(down)) << c.name << " toss " << i;
+    EXPECT_EQ(resting_outcome_label(m, face_down(m, s, highest)), resting_outcome_label(m, down)) << c.name << " toss " << i;
   }
   // Unresolved tosses are counted, not checked here; the irregular hull has ~0.6% (it hits the
   // impact cap: see the report of issue 11), the regular solids none.

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "fidelity_test_util.hpp"
+#include "sim/body/outcome.hpp"
 #include "sim/dynamics/contact_stepper.hpp"
 #include "sim/dynamics/rest.hpp"
 #include "sim/models/compile.hpp"
@@ -153,7 +154,6 @@ DieModel binom4(Fidelity f) {
   return compile(with_fidelity(load_scene(std::string(DICESIM_SOURCE_DIR) + "/scenes/dice/binom4.toml"), f));
 }
 
-int outcome_of(const DieModel& m, int face) { return m.face_outcome[static_cast<std::size_t>(result_face(m, face))]; }
 
 }  // namespace
 
@@ -167,7 +167,7 @@ TEST(RestGeometry, ABasinOfTheSameOutcomeIsNoWayOut) {
   for (int f = 0; f < m.face_count(); ++f) {
     const std::size_t fi = static_cast<std::size_t>(f);
     if (!std::isfinite(m.face_escape[fi])) continue;
-    if (m.outcome_labels[static_cast<std::size_t>(outcome_of(m, f))] == 3) {
+    if (resting_outcome_label(m, f) == 3) {
       ++pair;
       EXPECT_LT(m.face_escape[fi] - m.face_height[fi], 1e-6) << f;
       EXPECT_GT(m.outcome_escape[fi] - m.face_height[fi], 1e-3) << f;
@@ -194,11 +194,11 @@ TEST(ImpulseRest, TwoTrianglesOfOnePrintedFaceSettleAsOneOutcome) {
     const TossResult r = toss_to_end(m, 20261122, static_cast<std::uint64_t>(i), s);
     ASSERT_EQ(r.status, TossStatus::Settled) << "toss " << i;
     ++settled;
-    const int read = m.face_outcome[static_cast<std::size_t>(r.face_index)];  // face_index: the face read
+    const int read = m.outcome_labels[static_cast<std::size_t>(r.outcome)];
     FixedStepper st(m, m.contact_step);
     for (int k = 1; k <= 167; ++k) {
       st.step(s);
-      if (k % 16 == 0) ASSERT_EQ(outcome_of(m, quasi_static_down_face(m, s.R, 0.5)), read) << "toss " << i << " step " << k;
+      if (k % 16 == 0) ASSERT_EQ(resting_outcome_label(m, quasi_static_down_face(m, s.R, 0.5)), read) << "toss " << i << " step " << k;
     }
   }
   EXPECT_EQ(settled, 400);

@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include "sim/body/outcome.hpp"
 #include "sim/dynamics/contact.hpp"
 #include "sim/dynamics/rim_rest.hpp"
 #include "sim/sincos.hpp"
@@ -172,12 +173,17 @@ std::vector<Saddle> basin_saddles(const DieModel& m) {
 
 }  // namespace
 
-void compute_outcome_escape(DieModel& m) {
+void compute_escapes(DieModel& m) {
   const std::size_t F = static_cast<std::size_t>(m.face_count());
-  m.outcome_escape = m.face_escape;
-  if (!m.curved()) {
+  if (!m.curved()) {  // a cylinder's face_escape is compute_rim_rest_geometry's
     const std::vector<Saddle> saddles = basin_saddles(m);
-    auto outcome = [&](int f) { return m.face_outcome[static_cast<std::size_t>(m.face_result[static_cast<std::size_t>(f)])]; };
+    m.face_escape.assign(F, kInf);
+    for (const Saddle& sd : saddles) {
+      m.face_escape[static_cast<std::size_t>(sd.a)] = std::min(m.face_escape[static_cast<std::size_t>(sd.a)], sd.height);
+      m.face_escape[static_cast<std::size_t>(sd.b)] = std::min(m.face_escape[static_cast<std::size_t>(sd.b)], sd.height);
+    }
+    m.outcome_escape = m.face_escape;
+    auto outcome = [&](std::size_t f) { return resting_outcome_label(m, static_cast<int>(f)); };
     // Per basin A: the least, over paths of saddles, of the highest saddle on the path (a minimax
     // Dijkstra over the few basins), to every basin; the least of it over the basins read otherwise.
     std::vector<double> pass(F);
@@ -194,7 +200,7 @@ void compute_outcome_escape(DieModel& m) {
           if (!done[v] && pass[v] < kInf && (u == F || pass[v] < pass[u])) u = v;
         if (u == F || pass[u] >= out) break;
         done[u] = 1;
-        if (outcome(static_cast<int>(u)) != outcome(static_cast<int>(a))) {
+        if (outcome(u) != outcome(a)) {
           out = std::min(out, pass[u]);
           continue;
         }
@@ -206,6 +212,8 @@ void compute_outcome_escape(DieModel& m) {
       }
       m.outcome_escape[a] = out;
     }
+  } else {
+    m.outcome_escape = m.face_escape;
   }
   m.max_escape = 0.0;
   bool any_finite = false;
@@ -222,7 +230,6 @@ void compute_rest_geometry(DieModel& m) {
   const std::size_t F = static_cast<std::size_t>(nf);
   m.face_height.assign(F, 0.0);
   m.face_hold.assign(F, 0.0);
-  m.face_escape.assign(F, kInf);
   m.face_tip_ratio.assign(F, 0.0);
   m.face_gyro.assign(F, 0.0);
   m.face_area.assign(F, 0.0);
@@ -248,11 +255,6 @@ void compute_rest_geometry(DieModel& m) {
     m.face_tip_ratio[fi] = hold / (h + m.rounding);
     m.face_gyro[fi] = n.cross(I * n).norm();
     m.face_area[fi] = 0.5 * std::abs(area2.dot(n));
-  }
-
-  for (const Saddle& sd : basin_saddles(m)) {
-    m.face_escape[static_cast<std::size_t>(sd.a)] = std::min(m.face_escape[static_cast<std::size_t>(sd.a)], sd.height);
-    m.face_escape[static_cast<std::size_t>(sd.b)] = std::min(m.face_escape[static_cast<std::size_t>(sd.b)], sd.height);
   }
 }
 

@@ -18,23 +18,24 @@
 
 namespace dicesim {
 
-// Fills the face_* fields of a model whose vertices, faces (loops, normals, across), adjacency,
-// frictions, rounding and principal moments are set. The basin barrier face_escape[B] is the lowest
-// saddle on the boundary of B's basin: the die balanced on an edge with its COM straight above it
-// (a critical point of the COM height only where the COM projects inside the edge and the vertical
-// lies between the edge's two face normals), height = distance from the COM to the edge + rounding,
-// separating the basins the two sides roll to.
+// Fills the face_* fields but face_escape of a model whose vertices, faces (loops, normals,
+// across), adjacency, frictions, rounding and principal moments are set.
 void compute_rest_geometry(DieModel& m);
 
-// Fills outcome_escape and max_escape once the faces' reads are final (compile calls it after
-// compute_rest_geometry and the read ties): outcome_escape[A] is the lowest pass out of the region
-// of basins that read as A's outcome, the least over paths of saddles from A's basin to a basin
-// read as another outcome of the highest saddle on the path. Below it the die can wander between
-// basins of its outcome (two triangles of one printed face, 1 degree apart, with a saddle 0.1 um
-// above them) but never reach another outcome, so the outcome is settled. Where every neighbouring
-// basin reads differently (every ready die but binom4) it equals face_escape. A cylinder's is its
-// face_escape.
-void compute_outcome_escape(DieModel& m);
+// Fills face_escape, outcome_escape and max_escape once the faces' reads are final (compile calls
+// it after compute_rest_geometry and the read ties; for a cylinder after compute_rim_rest_geometry,
+// whose face_escape it keeps). One pass over the saddles serves both: the die balanced on an edge
+// with its COM straight above it (a critical point of the COM height only where the COM projects
+// inside the edge and the vertical lies between the edge's two face normals), height = distance
+// from the COM to the edge + rounding, separating the basins the two sides roll to.
+// face_escape[B] is the lowest saddle on the boundary of B's basin. outcome_escape[A] is the lowest
+// pass out of the region of basins that read as A's outcome: the least over paths of saddles from
+// A's basin to a basin read as another outcome of the highest saddle on the path. Below it the die
+// can wander between basins of its outcome (two triangles of one printed face, 1 degree apart,
+// with a saddle 0.1 um above them) but never reach another outcome, so the outcome is settled.
+// Where every neighbouring basin reads differently (every ready die but binom4) it equals
+// face_escape; a cylinder's is its face_escape.
+void compute_escapes(DieModel& m);
 
 // Quasi-static roll from orientation R (body -> world) standing on its lowest corner: pivot about
 // that corner in the vertical plane through it and the COM until an edge touches (steepest

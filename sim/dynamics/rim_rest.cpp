@@ -37,9 +37,6 @@ void compute_rim_rest_geometry(DieModel& m) {
   const Mat3 I = m.principal_moments.asDiagonal();
   m.face_gyro = {k.cross(I * k).norm(), k.cross(I * k).norm(), 0.0};
   m.face_area = {kPi * rim.radius * rim.radius, kPi * rim.radius * rim.radius, 2.0 * kPi * rim.radius * 2.0 * rim.half};
-  m.max_escape = 0.0;
-  for (int f = 0; f < 3; ++f)
-    if (m.face_hold[f] >= 0.0) m.max_escape = std::max(m.max_escape, m.face_escape[f]);
 }
 
 int rim_quasi_static_down(const DieModel& m, const Mat3& R, double tiebreak) {

@@ -20,7 +20,8 @@
 
 namespace dicesim {
 
-// Fills face_height, face_hold, face_escape, face_tip_ratio, face_gyro, face_area, max_escape.
+// Fills face_height, face_hold, face_escape, face_tip_ratio, face_gyro and face_area
+// (max_escape: compute_escapes, rest.hpp).
 void compute_rim_rest_geometry(DieModel& m);
 
 // The quasi-static roll from orientation R: steepest descent of sigma on the sphere of down

@@ -253,7 +253,7 @@ DieModel compile_cylinder(const Body& body, const SceneDef& scene, const std::st
   build_outcomes(m);
   m.face_result = {1, 0, 2};  // heads face down shows tails, tails face down heads, the side edge
   compute_rim_rest_geometry(m);
-  compute_outcome_escape(m);
+  compute_escapes(m);
   find_alike_outcomes(m, body, scene);
   m.max_friction = *std::max_element(m.vertex_friction.begin(), m.vertex_friction.end());
   finish_model(m, scene, origin);
@@ -299,7 +299,7 @@ DieModel compile_body(const Body& body, const SceneDef& scene, const std::string
 
   compute_rest_geometry(m);
   resolve_read_ties(m, origin);
-  compute_outcome_escape(m);  // the reads are final now
+  compute_escapes(m);  // the reads are final now
   find_alike_outcomes(m, body, scene);
   m.max_friction = *std::max_element(m.vertex_friction.begin(), m.vertex_friction.end());
 
