@@ -17,6 +17,7 @@
 // m (g h)^2 / 8, split_gain; checked, and capped beyond it.)
 #pragma once
 
+#include <limits>
 #include <optional>
 
 #include "sim/body/die_model.hpp"
@@ -402,7 +403,8 @@ class FixedStepper {
   ImpactResult imp_;      // that impact's result
 };
 
-enum class StepperExit { Settled, LiftOff, Unresolved };
+// Paused: the time t_pause reached (a world toss's window: run_fixed_steps).
+enum class StepperExit { Settled, LiftOff, Unresolved, Paused };
 
 struct StepperOutcome {
   StepperExit exit = StepperExit::Unresolved;
@@ -460,14 +462,22 @@ struct StepperStats {
   std::uint64_t rise_dropped = 0;  // `impulse`: steps whose held corners' rise was dropped (it would gain energy)
 };
 
+// No pause: run_fixed_steps steps on to rest, lift-off or a cap.
+inline constexpr double kNoPause = std::numeric_limits<double>::infinity();
+// A pause this close (in steps) counts as reached: rounding of t's sum never leaves a sliver step.
+inline constexpr double kPauseSlack = 1e-9;
+
 // Steps from (s, t) until the die must come to rest (sim/rest.hpp), the time cap, the impact cap
 // (`impacts` counts on), or, with allow_liftoff, until no corner touches or will touch within two
 // steps (the caller's exact flight takes over). A die at rest in an exact unstable balance (on an
 // edge or corner) gets an infinitesimal spin whose direction comes from `tiebreak`. `stats`, if
 // given, accumulates the corrections, sweeps and energy check of the steps.
 // adaptive.tol > 0: `impulse`'s leapfrog steps of error-controlled length, h their ceiling.
+// t_pause: a world toss's window end (world_toss.cpp): the last step is shortened to end there,
+// and the stepper returns Paused with t == t_pause (to kPauseSlack steps).
 StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int& impacts, double h, double tiebreak,
                                bool allow_liftoff, ImpactThreshold threshold = ImpactThreshold::Gravity,
-                               StepperStats* stats = nullptr, double max_sink = 0.0, const AdaptiveSteps& adaptive = {});
+                               StepperStats* stats = nullptr, double max_sink = 0.0, const AdaptiveSteps& adaptive = {},
+                               double t_pause = kNoPause);
 
 }  // namespace dicesim

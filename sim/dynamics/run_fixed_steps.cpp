@@ -14,7 +14,7 @@ namespace dicesim {
 
 StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int& impacts, double h, double tiebreak,
                                bool allow_liftoff, ImpactThreshold threshold, StepperStats* stats, double max_sink,
-                               const AdaptiveSteps& adaptive) {
+                               const AdaptiveSteps& adaptive, double t_pause) {
   StepperOutcome out;
   FixedStepper st(m, h, threshold, max_sink, adaptive);
   st.impacts = impacts;
@@ -27,45 +27,51 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
   if (adaptive.tol > 0.0 && adaptive.floor > 0.0) h_min = std::min(h_min, adaptive.floor);
   const auto max_steps = 4 * static_cast<long long>(std::ceil((m.max_time - t) / h_min)) + 1000;
   std::uint64_t steps = 0;
+  // A stepper's counters into the statistics (the main stepper at the end, a pause's tail stepper
+  // as soon as it has stepped).
+  const auto absorb = [&](const FixedStepper& x) {
+    if (!stats) return;
+    stats->corrections.add(x.corrections);
+    stats->sweeps += x.sweeps;
+    stats->located += x.located;
+    stats->located_trials += x.located_trials;
+    stats->located_capped += x.located_capped;
+    stats->max_energy_gain = std::max(stats->max_energy_gain, x.max_energy_gain);
+    stats->max_step_rise = std::max(stats->max_step_rise, x.max_step_rise);
+    stats->max_rise_excess = std::max(stats->max_rise_excess, x.max_rise_excess);
+    stats->max_penetration = std::max(stats->max_penetration, x.max_penetration);
+    stats->halved += x.halved;
+    stats->curvature_capped += x.curvature_capped;
+    stats->support_search_capped += x.support_search_capped;
+    stats->slaps += x.slaps;
+    stats->slap_no_arrival += x.slap_no_arrival;
+    stats->slap_rim_below += x.slap_rim_below;
+    stats->flat_landed += x.flat_landed;
+    stats->face_jumped += x.face_jumped;
+    stats->face_jump_declined += x.face_jump_declined;
+    stats->rim_struck += x.rim_struck;
+    stats->rim_strike_declined += x.rim_strike_declined;
+    stats->dual_solves += x.dual_solves;
+    stats->exact_fallbacks += x.exact_fallbacks;
+    stats->max_held_sink = std::max(stats->max_held_sink, x.max_held_sink);
+    stats->held_sinks += x.held_sinks;
+    stats->sink_shortened += x.sink_shortened;
+    stats->short_steps += x.short_steps;
+    stats->rise_dropped += x.rise_dropped;
+    // The guards of the sustained phase, reported with the corrections (kept out of the
+    // stepper's own, whose totals decide its re-tried steps).
+    stats->corrections.located_capped += static_cast<std::uint32_t>(x.located_capped);
+    stats->corrections.support_search_capped += static_cast<std::uint32_t>(x.support_search_capped);
+    stats->corrections.rise_dropped += static_cast<std::uint32_t>(x.rise_dropped);
+  };
   const auto finish = [&](StepperExit exit) {
     out.exit = exit;
     if (stats && stats->observer) stats->observer->on_step(t, s);
     impacts = st.impacts;
+    absorb(st);
     if (stats) {
-      stats->corrections.add(st.corrections);
-      stats->sweeps += st.sweeps;
       stats->steps += steps;
-      stats->located += st.located;
-      stats->located_trials += st.located_trials;
-      stats->located_capped += st.located_capped;
       stats->nudges += static_cast<std::uint64_t>(out.nudges);
-      stats->max_energy_gain = std::max(stats->max_energy_gain, st.max_energy_gain);
-      stats->max_step_rise = std::max(stats->max_step_rise, st.max_step_rise);
-      stats->max_rise_excess = std::max(stats->max_rise_excess, st.max_rise_excess);
-      stats->max_penetration = std::max(stats->max_penetration, st.max_penetration);
-      stats->halved += st.halved;
-      stats->curvature_capped += st.curvature_capped;
-      stats->support_search_capped += st.support_search_capped;
-      stats->slaps += st.slaps;
-      stats->slap_no_arrival += st.slap_no_arrival;
-      stats->slap_rim_below += st.slap_rim_below;
-      stats->flat_landed += st.flat_landed;
-      stats->face_jumped += st.face_jumped;
-      stats->face_jump_declined += st.face_jump_declined;
-      stats->rim_struck += st.rim_struck;
-      stats->rim_strike_declined += st.rim_strike_declined;
-      stats->dual_solves += st.dual_solves;
-      stats->exact_fallbacks += st.exact_fallbacks;
-      stats->max_held_sink = std::max(stats->max_held_sink, st.max_held_sink);
-      stats->held_sinks += st.held_sinks;
-      stats->sink_shortened += st.sink_shortened;
-      stats->short_steps += st.short_steps;
-      stats->rise_dropped += st.rise_dropped;
-      // The guards of the sustained phase, reported with the corrections (kept out of the
-      // stepper's own, whose totals decide its re-tried steps).
-      stats->corrections.located_capped += static_cast<std::uint32_t>(st.located_capped);
-      stats->corrections.support_search_capped += static_cast<std::uint32_t>(st.support_search_capped);
-      stats->corrections.rise_dropped += static_cast<std::uint32_t>(st.rise_dropped);
       stats->corrections.nudges += static_cast<std::uint32_t>(out.nudges);
     }
     return out;
@@ -89,10 +95,27 @@ StepperOutcome run_fixed_steps(const DieModel& m, RigidState& s, double& t, int&
         if (!(k < max_steps && t < m.max_time)) break;
       }
     }
-    const int n = st.step(s, ke);
-    ke = st.end_ke();
+    int n;
+    if (t_pause - t <= kPauseSlack * h) return finish(StepperExit::Paused);
+    if (t + st.h() > t_pause) {
+      // The window ends inside the next step: a step of exactly what is left (its impact threshold
+      // still the full step's), so that every die of a world toss stands at the window's end.
+      AdaptiveSteps tail_steps = adaptive;
+      tail_steps.tol = 0.0;
+      if (!(tail_steps.threshold_step > 0.0)) tail_steps.threshold_step = st.h();
+      FixedStepper tail(m, t_pause - t, threshold, max_sink, tail_steps);
+      tail.impacts = st.impacts;
+      n = tail.step(s, ke);
+      ke = tail.end_ke();
+      st.impacts = tail.impacts;
+      t += tail.last_dt();
+      absorb(tail);
+    } else {
+      n = st.step(s, ke);
+      ke = st.end_ke();
+      t += st.last_dt();
+    }
     ++steps;
-    t += st.last_dt();
     if (stats && stats->observer) stats->observer->on_step(t, s);
     if (st.impacts >= m.max_bounces) break;
     if (n == 0) {

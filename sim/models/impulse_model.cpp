@@ -9,80 +9,81 @@
 
 #include "sim/dynamics/contact_stepper.hpp"
 #include "sim/models/fidelity_models.hpp"
+#include "sim/models/impulse_run.hpp"
 #include "sim/dynamics/friction_impact.hpp"
 #include "sim/dynamics/rest.hpp"
 #include "sim/scene/scene.hpp"
 
 namespace dicesim {
 
-TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossProbe* probe) {
-  TossResult r;
-  double t = 0.0;
-  const double set_tol = 1e-6 * m.bounding_radius;  // corners this close strike together
+void ImpulseRun::advance(double t_stop, TossProbe* probe) {
+  const DieModel& md = *m;
+  const double set_tol = 1e-6 * md.bounding_radius;  // corners this close strike together
   // A polyhedron's sustained contact: leapfrog steps of error-controlled length (contact_tol), the
   // contact step their ceiling, and the impact threshold a fixed speed (the shape's default step),
   // whatever the ceiling. A curved die's steps are drift-kick-drift at the fixed contact_step
   // (FixedStepper, rim_step.cpp: second order without error control), its threshold 4 g
   // contact_step.
-  const bool adaptive_steps = !m.curved() && m.contact_tol > 0.0;
-  const double v_sustained = sustained_contact_speed(m, adaptive_steps ? m.sustained_step : m.contact_step);
-  const AdaptiveSteps adaptive{.tol = adaptive_steps ? m.contact_tol : 0.0,
-                               .floor = std::min(kContactStepFloor, m.contact_step),
-                               .threshold_step = adaptive_steps ? m.sustained_step : 0.0};
-  bool sustained = false;
-  bool after_impact = false;  // the state is right after an impact (sustained contact is possible)
-  StepperStats stats;
+  const bool adaptive_steps = !md.curved() && md.contact_tol > 0.0;
+  const double v_sustained = sustained_contact_speed(md, adaptive_steps ? md.sustained_step : md.contact_step);
+  const AdaptiveSteps adaptive{.tol = adaptive_steps ? md.contact_tol : 0.0,
+                               .floor = std::min(kContactStepFloor, md.contact_step),
+                               .threshold_step = adaptive_steps ? md.sustained_step : 0.0};
   if (probe) stats.observer = probe->steps_observer;
-  const auto finish = [&](TossStatus status) {
-    if (probe && probe->final_state) *probe->final_state = s;
-    r.status = status;
-    r.t_end = t;
-    r.corrections.add(stats.corrections);
-    if (probe) add_stepper_stats(*probe, stats);
-    return r;
-  };
   const auto settle = [&](int down) {
-    set_result_face(m, result_face(m, down), r);
-    return finish(TossStatus::Settled);
+    face_down = down;
+    state = RunState::Settled;
   };
+  const auto unresolved = [&] { state = RunState::Unresolved; };
+  if (state != RunState::Running) return;
   for (;;) {
     if (sustained) {
       const PhaseTimer timer(probe, Phase::Steps);
-      const StepperOutcome o =
-          run_fixed_steps(m, s, t, r.bounces, m.contact_step, tiebreak, /*allow_liftoff=*/true, ImpactThreshold::Gravity, &stats,
-                          held_corner_sink(m), adaptive);
+      const StepperOutcome o = run_fixed_steps(md, s, t, bounces, md.contact_step, tiebreak, /*allow_liftoff=*/true,
+                                               ImpactThreshold::Gravity, &stats, held_corner_sink(md), adaptive, t_stop);
       if (o.exit == StepperExit::Settled) return settle(o.face_down);
-      if (o.exit == StepperExit::Unresolved) break;
+      if (o.exit == StepperExit::Unresolved) return unresolved();
+      if (o.exit == StepperExit::Paused) return;
       sustained = false;  // lift-off: back to exact flight
       s.R = Quat(s.R).normalized().toRotationMatrix();
     }
     int down;
     {
       const PhaseTimer timer(probe, Phase::Rest);
-      down = rest_face_down(m, s, tiebreak);
+      down = rest_face_down(md, s, tiebreak);
     }
     if (down >= 0) return settle(down);
+    if (t >= t_stop) return;
 
     PhaseTimer search_timer(probe, Phase::Search);  // flight, contact search and contact set
-    const Flight flight(m, s);
-    const ContactSearch c = flight.next_contact(m.max_time - t);
+    const Flight flight(md, s);
+    const double t_limit = std::min(md.max_time, t_stop);
+    const ContactSearch c = flight.next_contact(t_limit - t);
     if (probe) {
       probe->search_iterations += static_cast<std::uint64_t>(c.iterations);
       ++probe->flights;
     }
     if (c.outcome != ContactSearch::Outcome::Contact) {
+      if (t_stop < md.max_time && c.outcome == ContactSearch::Outcome::TimeLimit) {
+        // The window ends in flight: the exact state there, the flight picked up from it.
+        s = flight.state(t_stop - t);
+        s.R = Quat(s.R).normalized().toRotationMatrix();
+        since_impact += t_stop - t;
+        t = t_stop;
+        return;
+      }
       t += c.t;
-      break;
+      return unresolved();
     }
     RigidState at = c.at;  // = flight.state(c.t): the search evaluated the rotation there already
     at.R = Quat(at.R).normalized().toRotationMatrix();
-    const ContactSet set = touching_corners(m, at, set_tol);
+    const ContactSet set = touching_corners(md, at, set_tol);
     // A slow re-landing within one contact step is sustained contact: the stepper takes over from
     // the state after the impact. (The one search from that state decides it and, if not, is the
     // next flight's.)
-    if (after_impact && c.t <= m.contact_step) {
+    if (after_impact && since_impact + c.t <= md.contact_step) {
       double approach = 0.0;
-      for (int i = 0; i < set.n; ++i) approach = std::min(approach, corner_velocity(m, at, set.vertex[i]).z());
+      for (int i = 0; i < set.n; ++i) approach = std::min(approach, corner_velocity(md, at, set.vertex[i]).z());
       if (-approach <= v_sustained) {
         sustained = true;
         after_impact = false;
@@ -92,12 +93,13 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
     search_timer.stop();
     const PhaseTimer impact_timer(probe, Phase::Impact);
     after_impact = false;
+    since_impact = 0.0;
     t += c.t;
     s = at;
     const RigidState before = s;
-    const ImpactResult imp = apply_friction_impact(m, s, set, /*restitution=*/true);
-    r.corrections.add(imp.corrections);
-    ++r.bounces;
+    const ImpactResult imp = apply_friction_impact(md, s, set, /*restitution=*/true);
+    corrections.add(imp.corrections);
+    ++bounces;
     if (probe) {
       probe->pgs_sweeps += static_cast<std::uint64_t>(imp.iterations);
       probe->dual_solves += static_cast<std::uint64_t>(imp.dual_solves);
@@ -106,12 +108,30 @@ TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossPro
         probe->max_energy_gain =
             std::max(probe->max_energy_gain, (imp.energy_after - imp.energy_before) / imp.energy_before);
       if (probe->trace)
-        probe->trace->push_back({r.bounces, t, before, s, set.n > 0 ? set.vertex[0] : -1, imp.normal_impulse});
+        probe->trace->push_back({bounces, t, before, s, set.n > 0 ? set.vertex[0] : -1, imp.normal_impulse});
     }
-    if (r.bounces >= m.max_bounces) break;
+    if (bounces >= md.max_bounces) return unresolved();
     after_impact = true;
   }
-  return finish(TossStatus::Unresolved);
+}
+
+TossResult ImpulseRun::result(TossProbe* probe) {
+  TossResult r;
+  if (probe && probe->final_state) *probe->final_state = s;
+  r.status = state == RunState::Settled ? TossStatus::Settled : TossStatus::Unresolved;
+  r.t_end = t;
+  r.bounces = bounces;
+  r.corrections = corrections;
+  r.corrections.add(stats.corrections);
+  if (probe) add_stepper_stats(*probe, stats);
+  if (state == RunState::Settled) set_result_face(*m, result_face(*m, face_down), r);
+  return r;
+}
+
+TossResult run_impulse(const DieModel& m, RigidState s, double tiebreak, TossProbe* probe) {
+  ImpulseRun run(m, s, tiebreak);
+  run.advance(kRunForever, probe);
+  return run.result(probe);
 }
 
 }  // namespace dicesim
