@@ -20,8 +20,12 @@ Aggregator::Aggregator(AggregatorConfig cfg, Send send)
       all_(static_cast<int>(outcomes_)),
       sealer_(cfg_.key) {
   if (!wire::valid_outcome_labels(std::vector<std::int32_t>(cfg_.spec.labels.begin(), cfg_.spec.labels.end())))
-    throw std::invalid_argument("the run's outcome labels are not 1 to " + std::to_string(wire::kMaxOutcomes) +
-                                " ascending labels in [0, " + std::to_string(wire::kMaxLabel) + "]");
+    throw std::invalid_argument("the run's " + std::to_string(cfg_.spec.labels.size()) + " outcome labels (" +
+                                (cfg_.spec.labels.empty() ? std::string("none")
+                                                          : std::to_string(cfg_.spec.labels.front()) + " to " +
+                                                                std::to_string(cfg_.spec.labels.back())) +
+                                ") are not 1 to " + std::to_string(wire::kMaxOutcomes) + " ascending labels in [0, " +
+                                std::to_string(wire::kMaxLabel) + "], what the wire carries (several dice: read their sum)");
 }
 
 namespace {
@@ -151,7 +155,7 @@ bool Aggregator::valid_batch(const dicesim_lcm::toss_batch& b) const {
   if (b.count < 1 || b.outcomes.size() != n || b.statuses.size() != n || b.bounces.size() != n) return false;
   const std::size_t nc = static_cast<std::size_t>(b.n_corrected);
   const std::vector<std::int32_t>* kinds[] = {&b.energy_clamps, &b.pgs_unconverged, &b.overlap_fixes, &b.fallbacks,
-                                              &b.located_capped, &b.support_search_capped, &b.rise_dropped, &b.depth_held,
+                                              &b.located_capped, &b.support_search_capped, &b.rise_dropped, &b.contact_overlaps,
                                               &b.nudges};
   static_assert(std::size(kinds) == RunCorrections::kKinds);
   if (b.n_corrected < 0 || b.corrected_offset.size() != nc) return false;
@@ -236,7 +240,7 @@ void Aggregator::ingest(std::uint64_t first, std::uint64_t lo, std::uint64_t hi,
       c.corrections.located_capped += static_cast<std::uint64_t>(b.located_capped[j]);
       c.corrections.support_search_capped += static_cast<std::uint64_t>(b.support_search_capped[j]);
       c.corrections.rise_dropped += static_cast<std::uint64_t>(b.rise_dropped[j]);
-      c.corrections.depth_held += static_cast<std::uint64_t>(b.depth_held[j]);
+      c.corrections.contact_overlaps += static_cast<std::uint64_t>(b.contact_overlaps[j]);
       c.corrections.nudges += static_cast<std::uint64_t>(b.nudges[j]);
     }
     blocks_.try_emplace(block, static_cast<int>(outcomes_)).first->second.merge(c);

@@ -11,6 +11,7 @@
 #include "sim/body/die_model.hpp"
 #include "sim/body/material_parts.hpp"
 #include "sim/body/outcome.hpp"
+#include "sim/body/world.hpp"
 #include "sim/models/compile.hpp"
 #include "sim/models/fidelity_models.hpp"
 #include "sim/study/auto_pilot.hpp"
@@ -51,6 +52,10 @@ void print_info(const std::string& path, const DieModel& m, const FloorDef& floo
   double volume = 0.0;
   for (const MaterialPart& p : parts) volume += p.volume;
   std::printf("%s%s%s\n\n", path.c_str(), m.name.empty() ? "" : ": ", m.name.c_str());
+  if (m.world)
+    std::printf("world              %d dice, %zu obstacle pieces; %d outcomes (%s), labels %d to %d; below: the first die\n",
+                m.world->size(), m.world->pieces.size(), m.outcomes(),
+                m.world->kind == OutcomeKind::Sum ? "sums" : "tuples", m.outcome_labels.front(), m.outcome_labels.back());
   std::printf("shape              %s: %d corners, %d faces, %d outcomes, read %s%s\n", m.kind.c_str(), m.vertex_count(),
               m.face_count(), m.outcomes(), m.read_down ? "down (the face on the floor)" : "up",
               m.convex ? "" : "  (not convex: contact uses its hull)");

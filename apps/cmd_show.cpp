@@ -33,6 +33,10 @@ int run_show(const ShowArgs& a) {
     throw SceneError("dicesim show", "--toss", std::to_string(a.toss),
                      "outside the run's toss indices 0.." + std::to_string(a.tosses - 1) + " (--tosses " +
                          std::to_string(a.tosses) + ")");
+  if (!def.dice.empty() || !def.obstacles.empty())
+    throw SceneError(a.scene.path, def.dice.empty() ? "obstacles" : "dice", "(given)",
+                     "dicesim show draws one die alone: a toss of several dice or among obstacles cannot be drawn yet "
+                     "(docs/world.md)");
   std::string out = a.output;
   if (out.empty()) {
     out = std::filesystem::path(a.scene.path).stem().string();

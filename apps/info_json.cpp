@@ -3,12 +3,11 @@
 #include "apps/info_json.hpp"
 
 #include <algorithm>
-
-#include "sim/body/outcome.hpp"
-
 #include <cmath>
 #include <vector>
 
+#include "sim/body/outcome.hpp"
+#include "sim/body/world.hpp"
 #include "sim/models/fidelity_models.hpp"
 
 namespace dicesim {
@@ -127,6 +126,10 @@ nlohmann::json info_json(const std::string& path, const DieModel& m, const std::
           {"faces", faces},
           {"alike", {{"groups", alike_groups(m)}, {"rotations", m.symmetry_rotations}, {"note", m.alike_note}}},
           {"corners", corners},
+          {"world", m.world ? nlohmann::json{{"dice", m.world->size()},
+                                              {"obstacle_pieces", m.world->pieces.size()},
+                                              {"kind", m.world->kind == OutcomeKind::Sum ? "sum" : "tuple"}}
+                            : nlohmann::json()},
           {"fidelity", to_string(m.fidelity)},
           {"fidelity_requested", to_string(m.fidelity_requested)},
           {"fidelity_reason", m.fidelity_reason},

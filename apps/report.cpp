@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sim/body/outcome.hpp"
+#include "sim/body/world.hpp"
 #include "sim/study/statistics.hpp"
 
 namespace dicesim {
@@ -249,7 +250,10 @@ void set_labels(RunReport& r, const DieModel& m) {
   r.fidelity_reason = m.fidelity_reason;
   r.labels = m.outcome_labels;
   r.faces_per_label.assign(m.outcome_labels.size(), 0);
-  for (const int k : m.face_outcome) ++r.faces_per_label[static_cast<std::size_t>(k)];
+  if (m.world)  // several dice: the face tuples that read each outcome
+    r.faces_per_label = m.world->faces_per_outcome;
+  else
+    for (const int k : m.face_outcome) ++r.faces_per_label[static_cast<std::size_t>(k)];
   r.names = outcome_names(m);
   r.alike = m.outcome_alike;
   r.symmetry_rotations = m.symmetry_rotations;

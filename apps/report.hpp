@@ -51,7 +51,7 @@ struct RunReport {
 //  probabilities within it), "chi2_uniform": the same when every outcome is alike (a fair die),
 //  else null; "chi2_heads_tails": a coin's group of heads and tails (edge landings left out), else null,
 //  "corrections": {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks", "located_capped",
-//  "support_search_capped", "rise_dropped", "depth_held", "nudges"} (totals over the run; the table prints a line only when one is non-zero), "elapsed_s", "tosses_per_s"} -- p and
+//  "support_search_capped", "rise_dropped", "contact_overlaps", "nudges"} (totals over the run; the table prints a line only when one is non-zero), "elapsed_s", "tosses_per_s"} -- p and
 //  intervals over settled tosses; "partial": true when interrupted (then "tosses" is the complete
 //  prefix run, "tosses_requested" what was asked), "tosses_requested", "provenance" (provenance.hpp); faces by label.
 //  Outcomes not alike by design are never tested against each other (sim/body/symmetry.hpp says

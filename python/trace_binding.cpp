@@ -66,6 +66,8 @@ pb::dict impact_columns(const DieModel& m, const std::vector<BounceRecord>& trac
 
 pb::dict toss_one(Scene& scene, std::uint64_t index, std::uint64_t seed, std::optional<std::string> fidelity, bool trace) {
   const std::shared_ptr<const DieModel> model = scene.model(fidelity);
+  if (trace && model->world)
+    throw pb::value_error("trace=True follows one die alone: a toss of several dice or among obstacles has no trace yet (docs/world.md)");
   const InitialState init = draw_initial_state(model->throw_, seed, index);
   std::vector<BounceRecord> records;
   TossProbe probe;

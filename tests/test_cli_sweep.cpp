@@ -79,7 +79,7 @@ TEST(CliSweep, EveryPointReportsItsCorrectionsAsTossDoes) {
   const auto k = nlohmann::json::parse(t.out)["corrections"];
   bool any = false;
   for (const char* key : {"energy_clamps", "pgs_unconverged", "overlap_fixes", "fallbacks", "located_capped",
-                          "support_search_capped", "rise_dropped", "depth_held", "nudges"}) {
+                          "support_search_capped", "rise_dropped", "contact_overlaps", "nudges"}) {
     ASSERT_TRUE(p["corrections"].contains(key)) << key;
     EXPECT_EQ(p["corrections"][key], k[key]) << key;
     any = any || k[key].get<long long>() > 0;

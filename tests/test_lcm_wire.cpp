@@ -54,7 +54,7 @@ TEST(LcmWire, TossBatchCarriesCorrections) {
   b.located_capped = {0, 3};
   b.support_search_capped = {4, 0};
   b.rise_dropped = {0, 5};
-  b.depth_held = {6, 0};
+  b.contact_overlaps = {6, 0};
   b.nudges = {0, 2};
   const auto bytes = w::encode(b);
   EXPECT_TRUE(w::plausible_toss_batch(bytes.data(), bytes.size()));
@@ -66,7 +66,7 @@ TEST(LcmWire, TossBatchCarriesCorrections) {
   EXPECT_EQ(d->located_capped, b.located_capped);
   EXPECT_EQ(d->support_search_capped, b.support_search_capped);
   EXPECT_EQ(d->rise_dropped, b.rise_dropped);
-  EXPECT_EQ(d->depth_held, b.depth_held);
+  EXPECT_EQ(d->contact_overlaps, b.contact_overlaps);
   EXPECT_EQ(d->nudges, b.nudges);
 }
 

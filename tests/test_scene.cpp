@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sim/models/compile.hpp"
+#include "scene_test_util.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/scene_error.hpp"
 #include "sim/study/monte_carlo.hpp"
@@ -30,44 +31,10 @@ density = 700.0
 material = "wood"
 )";
 
-// A private directory for scene files written by a test, removed afterwards.
-class TempDir {
- public:
-  TempDir() : dir_(fs::temp_directory_path() / ("dicesim_scene_test_" + std::to_string(::getpid()) + "_" +
-                                                 ::testing::UnitTest::GetInstance()->current_test_info()->name())) {
-    fs::create_directories(dir_);
-  }
-  ~TempDir() { fs::remove_all(dir_); }
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path p = dir_ / name;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p) << text;
-    return p.string();
-  }
-
- private:
-  fs::path dir_;
-};
-
-// The SceneError thrown by `f`, or a test failure if none is.
-template <class F>
-SceneError error_of(F&& f) {
-  try {
-    f();
-  } catch (const SceneError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no SceneError thrown";
-  return SceneError("", "", "", "");
-}
-
-SceneError parse_error(const std::string& text, const std::vector<std::string>& overrides = {}) {
-  return error_of([&] { parse_scene(text, "mem.toml", overrides); });
-}
-
-void expect_contains(const std::string& text, const std::string& part) {
-  EXPECT_NE(text.find(part), std::string::npos) << "'" << part << "' not in: " << text;
-}
+using dicesim::testing::error_of;
+using dicesim::testing::expect_contains;
+using dicesim::testing::parse_error;
+using dicesim::testing::TempDir;
 
 // ---- ready scenes -------------------------------------------------------------------------------
 

@@ -7,6 +7,7 @@
 // corner (contact_point() in sim/dynamics/flight.hpp).
 #pragma once
 
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -32,6 +33,8 @@ struct Rims {
   double half = 0.0;             // core half-height (outer height / 2 - rounding)
 };
 inline constexpr int kRimFeatures = 6;
+
+struct World;  // sim/body/world.hpp: several dice, obstacles
 
 struct DieModel {
   // Geometry in the body (principal, COM-centred) frame.
@@ -110,6 +113,9 @@ struct DieModel {
   bool catch_end = false;  // sim.end = "catch": exact flight to the catch time, no floor
 
   ThrowDef throw_;  // distributions of the initial state (geometric frame for orientation)
+  // Several dice or obstacles ([[dice]], [[obstacles]]): the world a toss runs in; this model is then
+  // the first die's with the toss's outcomes (outcome_labels: tuples or sums). Null: one die alone.
+  std::shared_ptr<const World> world;
   std::string name;
   std::string kind = "box";  // the scene's die.shape
   bool convex = true;        // false: a mesh whose solid is not its hull (contact uses the hull)

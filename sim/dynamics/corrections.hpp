@@ -22,7 +22,10 @@ struct CorrectionCounts {
   Count located_capped = 0;          // a new contact not located within the touch tolerance in the trials allowed
   Count support_search_capped = 0;   // curved dice: a support search out of iterations (its end above the floor taken)
   Count rise_dropped = 0;            // flat dice: held corners' rise dropped (it would gain energy), the plain step taken
-  Count depth_held = 0;              // retired with the first-order rim step (nothing sets it: 0); kept for the wire's and checkpoints' layout
+  // A world toss (several dice, obstacles): two bodies found overlapping after a window deeper than
+  // 1e-4 of the bounding radius (the floor's bound on a held corner's sink), struck and lifted out.
+  // (Its slot held the retired first-order rim step's depth_held, always 0.)
+  Count contact_overlaps = 0;
   Count nudges = 0;                  // an exact balance at rest broken by the toss's tiebreak (a spin of 1e-4 sqrt(g/r))
 
   static constexpr std::size_t kKinds = 9;
@@ -36,7 +39,7 @@ struct CorrectionCounts {
     f("located_capped", located_capped);
     f("support_search_capped", support_search_capped);
     f("rise_dropped", rise_dropped);
-    f("depth_held", depth_held);
+    f("contact_overlaps", contact_overlaps);
     f("nudges", nudges);
   }
   template <class F>
@@ -59,7 +62,7 @@ struct CorrectionCounts {
     located_capped += o.located_capped;
     support_search_capped += o.support_search_capped;
     rise_dropped += o.rise_dropped;
-    depth_held += o.depth_held;
+    contact_overlaps += o.contact_overlaps;
     nudges += o.nudges;
   }
   bool operator==(const CorrectionCounts&) const = default;

@@ -1,4 +1,5 @@
 #include "sim/models/compile.hpp"
+#include "sim/models/world_compile.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -263,6 +264,7 @@ DieModel compile_cylinder(const Body& body, const SceneDef& scene, const std::st
 }  // namespace
 
 DieModel compile(const SceneDef& scene, const std::string& origin) {
+  if (!scene.dice.empty() || !scene.obstacles.empty()) return compile_world(scene, origin);
   return compile_body(build_body(scene, origin), scene, origin);
 }
 

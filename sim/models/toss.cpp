@@ -7,7 +7,9 @@
 #include <Random123/philox.h>
 
 #include "sim/dynamics/contact.hpp"
+#include "sim/body/world.hpp"
 #include "sim/models/fidelity_models.hpp"
+#include "sim/models/world_toss.hpp"
 #include "sim/body/outcome.hpp"
 
 namespace dicesim {
@@ -167,13 +169,63 @@ TossResult run(const DieModel& m, const InitialState& init, double tiebreak, Tos
   return TossResult{};
 }
 
+// Die k's stream of a world toss: the first die's is the toss's own (seed, index), as alone.
+std::uint64_t die_seed(std::uint64_t seed, int k) {
+  return seed + static_cast<std::uint64_t>(k) * 0x9E3779B97F4A7C15ull;
+}
+
+// Several dice (sim/body/world.hpp): each die's throw from its own stream (hand = "shared": the
+// first die's release position and velocity for all), plus its offset; `static` reads each die
+// alone (no contact between them), `impulse` runs the world.
+TossResult toss_world(const DieModel& m, std::uint64_t seed, std::uint64_t index, TossProbe* probe) {
+  const World& w = *m.world;
+  const bool motion = m.fidelity != Fidelity::Static;
+  std::vector<RigidState> starts;
+  std::vector<double> tiebreaks;
+  InitialState first;
+  {
+    const PhaseTimer timer(probe, Phase::Draw);
+    for (int k = 0; k < w.size(); ++k) {
+      const DieModel& d = w.dice[static_cast<std::size_t>(k)];
+      InitialState init = draw_initial_state(d.throw_, die_seed(seed, k), index, motion);
+      if (k == 0) first = init;
+      else if (w.hand == HandKind::Shared) {
+        init.com_position = first.com_position;
+        init.velocity = first.velocity;
+      }
+      init.com_position += w.offsets[static_cast<std::size_t>(k)];
+      starts.push_back(to_body_state(d, init));
+      tiebreaks.push_back(tiebreak_of(die_seed(seed, k), index));
+      if (!starts_valid(d, starts.back())) return TossResult{};  // Invalid
+    }
+  }
+  if (m.fidelity == Fidelity::Static) {
+    const PhaseTimer timer(probe, Phase::Rest);
+    int tuple = 0;
+    for (int k = 0; k < w.size(); ++k) {
+      const TossResult one = run_static(w.dice[static_cast<std::size_t>(k)], starts[static_cast<std::size_t>(k)],
+                                        tiebreaks[static_cast<std::size_t>(k)]);
+      if (one.status != TossStatus::Settled) return one;
+      tuple += one.outcome * w.stride[static_cast<std::size_t>(k)];
+    }
+    TossResult r;
+    r.status = TossStatus::Settled;
+    r.outcome = w.tuple_outcome[static_cast<std::size_t>(tuple)];
+    r.face = m.outcome_labels[static_cast<std::size_t>(r.outcome)];
+    return r;
+  }
+  return run_world(m, starts, tiebreaks, probe);
+}
+
 }  // namespace
 
 TossResult toss_from(const DieModel& m, const InitialState& init, TossProbe* probe) {
+  if (m.world) return TossResult{};  // one initial state does not make a world's toss: Invalid
   return run(m, init, tiebreak_of(init), probe);
 }
 
 TossResult toss(const DieModel& m, std::uint64_t seed, std::uint64_t index, TossProbe* probe) {
+  if (m.world) return toss_world(m, seed, index, probe);
   InitialState init;
   {
     const PhaseTimer timer(probe, Phase::Draw);

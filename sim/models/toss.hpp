@@ -95,6 +95,16 @@ struct TossProbe {
   std::uint64_t sink_shortened = 0;    // flat dice, `impulse`: fixed steps tried again shorter for that bound
   std::uint64_t short_steps = 0;       // flat dice, `impulse`: fixed steps whose full length was below contact_step
   std::uint64_t rise_dropped = 0;      // flat dice, `impulse`: fixed steps whose held corners' rise would gain energy
+  // World tosses (several dice, obstacles; world_toss.cpp): windows of conservative advancement,
+  // contacts struck between two bodies (die and die, die and obstacle), dice struck at rest and
+  // moving again, narrow-phase calls that ended at their iteration cap (their best estimate taken).
+  std::uint64_t windows = 0;
+  std::uint64_t windows_halved = 0;  // ... taken again half as long (a nearly touching pair went too deep)
+  std::uint64_t interactions = 0;
+  std::uint64_t woken = 0;
+  std::uint64_t narrow_degenerate = 0;
+  double max_overlap = 0.0;  // the deepest overlap of two bodies found after a window (m), lifted out
+                             // (beyond 1e-4 r also counted: Corrections::contact_overlaps)
   RigidState* final_state = nullptr;           // impulse, stepped: the state when the toss ended
   StepObserver* steps_observer = nullptr;      // impulse, stepped: every state of the fixed steps (contact_stepper.hpp)
 };

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
 #include <toml++/toml.h>
 
 #include "sim/scene/scene_error.hpp"
@@ -167,6 +168,15 @@ constexpr Range kCatchTime{.lo = 0, .hi = 1e3, .lo_open = true, .unit = "s"};
 constexpr Range kCatchTimeSd{.lo = 0, .hi = 1e3, .unit = "s"};
 constexpr Range kTiltSd{.lo = 0, .hi = 180, .unit = "deg"};
 constexpr Names<bool, 2> kHeightKinds{{{"normal", false}, {"fixed", true}}};  // value: is fixed
+constexpr Names<HandKind, 2> kHandKinds{{{"each", HandKind::Each}, {"shared", HandKind::Shared}}};
+constexpr Names<OutcomeKind, 2> kOutcomeKinds{{{"tuple", OutcomeKind::Tuple}, {"sum", OutcomeKind::Sum}}};
+// Several dice and obstacles (issue 41).
+constexpr Range kOffset{.lo = -1, .hi = 1, .unit = "m"};  // and |offset| <= 1 m
+constexpr Range kPosition{.lo = -1e6, .hi = 1e6, .unit = "m"};
+constexpr Range kYaw{.lo = -3600, .hi = 3600, .unit = "deg"};
+constexpr Range kBaffleAngle{.lo = 0, .hi = 90, .lo_open = true, .hi_open = true, .unit = "deg"};
+constexpr Range kBaffleReach{.lo = 0, .hi = 1, .lo_open = true};
+constexpr int kMinDice = 2, kMaxDice = 6;
 
 // ---- Reading one table -----------------------------------------------------------------------
 
@@ -535,6 +545,7 @@ void read_throw(Reader th, ThrowDef& def) {
     ct.finish();
     def.catch_time = c;
   }
+  if (th.get("hand")) def.hand = th.choice("hand", kHandKinds, def.hand).second;  // build(): only with [[dice]]
   th.finish();
 }
 
@@ -542,6 +553,225 @@ void read_floor(Reader floor, FloorDef& def) {
   if (auto e = floor.number("restitution", kRestitution)) def.restitution = e;
   if (auto mu = floor.number("friction", kFriction)) def.friction = mu;
   floor.finish();
+}
+
+// ---- Several dice and obstacles (issue 41) ----------------------------------------------------
+
+// A [[dice]] entry's `scene`: that scene's die and materials, and its canonical text (the hash).
+struct DieSource {
+  DieDef die;
+  std::map<std::string, MaterialDef> materials;
+  std::string canonical_text;
+};
+DieSource load_die_scene(Reader& entry);  // below, beside the files it reads
+
+bool same_material(const MaterialDef& a, const MaterialDef& b) {
+  return a.density == b.density && a.restitution == b.restitution && a.friction == b.friction &&
+         a.rolling_resistance == b.rolling_resistance && a.pivoting_resistance == b.pivoting_resistance;
+}
+
+// `dice_scene_texts` (when given): per entry, the canonical text of the scene it names ("" for this
+// scene's own [die]).
+void read_dice(Reader& top, SceneDef& s, bool has_die, std::vector<std::string>* dice_scene_texts) {
+  const toml::node* node = top.get("dice");
+  std::vector<Reader> entries = top.tables("dice");
+  if (entries.size() < static_cast<std::size_t>(kMinDice) || entries.size() > static_cast<std::size_t>(kMaxDice)) {
+    const std::string file = node->source().path ? *node->source().path : top.origin();
+    const std::string count = std::to_string(entries.size()) + (entries.size() == 1 ? " entry" : " entries");
+    throw SceneError(file, "dice", count,
+                     "must have " + std::to_string(kMinDice) + " to " + std::to_string(kMaxDice) + " entries" +
+                         (entries.size() == 1 ? " (one die: use [die] and leave out [[dice]])" : ""));
+  }
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    Reader& e = entries[i];
+    DiceEntryDef d;
+    d.scene = e.string("scene").value_or("");
+    std::string text;
+    if (d.scene.empty()) {
+      if (!has_die)
+        e.fail_missing("scene", "the path of a scene file whose [die] this die is (this scene has no [die] for the entry to use)");
+      d.die = s.die;
+      d.materials = s.materials;
+      if (d.die.shape == ShapeKind::Cylinder) {
+        Reader die = top.sub("die");
+        die.fail(die.get("shape"), "die.shape",
+                 "a curved die (\"cylinder\") cannot be one of [[dice]]: several dice and obstacles: polyhedral dice only");
+      }
+    } else {
+      DieSource src = load_die_scene(e);
+      if (src.die.shape == ShapeKind::Cylinder)
+        e.fail(e.get("scene"), e.path_of("scene"),
+               "names a curved die (shape = \"cylinder\"): several dice and obstacles: polyhedral dice only");
+      d.die = std::move(src.die);
+      d.materials = std::move(src.materials);
+      text = std::move(src.canonical_text);
+    }
+    d.offset = e.vec3("offset", kOffset, d.offset, false);
+    if (d.offset.norm() > 1.0)
+      e.fail(e.get("offset"), e.path_of("offset"),
+             "must be an array of 3 numbers (m) of length at most 1 m; its length is " + num_text(d.offset.norm()) + " m");
+    e.finish();
+    s.dice.push_back(std::move(d));
+    if (dice_scene_texts) dice_scene_texts->push_back(std::move(text));
+  }
+  if (has_die) return;
+  // No [die]: the first entry's die stands for the scene's die, with its materials.
+  s.die = s.dice.front().die;
+  for (const auto& [name, m] : s.dice.front().materials) {
+    const auto [it, fresh] = s.materials.emplace(name, m);
+    if (!fresh && !same_material(it->second, m))
+      entries.front().fail(entries.front().get("scene"), entries.front().path_of("scene"),
+                           "this scene has no [die], so the first entry's die stands for it, and that die's scene "
+                           "defines material '" + name + "' unlike this scene's [materials." + name +
+                               "]: rename one of them");
+  }
+}
+
+// The points span a solid: their spread about the centroid has a third direction, at least 1e-6 of
+// the largest (the hull's tolerance, sim/body/hull.hpp, measured the same relative way).
+bool spans_solid(const std::vector<Vec3>& points) {
+  if (points.size() < 4) return false;
+  Vec3 c = Vec3::Zero();
+  for (const Vec3& p : points) c += p;
+  c /= static_cast<double>(points.size());
+  Mat3 spread = Mat3::Zero();
+  for (const Vec3& p : points) spread += (p - c) * (p - c).transpose();
+  const Vec3 var = Eigen::SelfAdjointEigenSolver<Mat3>(spread, Eigen::EigenvaluesOnly).eigenvalues();  // ascending
+  return var.z() > 0.0 && std::sqrt(std::max(0.0, var.x()) / var.z()) > 1e-6;
+}
+
+void read_obstacle(Reader& o, const std::map<std::string, MaterialDef>& materials, ObstacleDef& def) {
+  {
+    const toml::node* n = o.get("kind");
+    std::string allowed;
+    for (const char* k : kObstacleKindNames) allowed += (allowed.empty() ? "" : ", ") + toml_string(k);
+    if (!n) o.fail_missing("kind", "one of: " + allowed);
+    const std::string name = o.string("kind").value_or("");
+    const auto it = std::find(kObstacleKindNames.begin(), kObstacleKindNames.end(), name);
+    if (it == kObstacleKindNames.end()) o.fail(n, o.path_of("kind"), "must be one of: " + allowed);
+    def.kind = static_cast<ObstacleKind>(it - kObstacleKindNames.begin());
+  }
+  const ObstacleKind kind = def.kind;
+  using K = ObstacleKind;
+  const std::string kind_text = std::string("kind = \"") + kObstacleKindNames[static_cast<int>(kind)] + "\"";
+  // A key the kind does not use is an error, not silently ignored.
+  auto only_for = [&](std::string_view key, std::initializer_list<K> kinds) {
+    const toml::node* n = o.get(key);
+    if (!n || std::find(kinds.begin(), kinds.end(), kind) != kinds.end()) return;
+    std::string which;
+    for (K k : kinds) which += (which.empty() ? "" : ", ") + toml_string(kObstacleKindNames[static_cast<int>(k)]);
+    o.fail(n, o.path_of(key), "does not apply to " + kind_text + "; it is for kind " + which);
+  };
+  only_for("point", {K::Plane});
+  only_for("normal", {K::Plane});
+  only_for("vertices", {K::Polyhedron});
+  only_for("centre", {K::Box, K::Tray, K::Backboard, K::Tower, K::Cup});
+  only_for("size", {K::Box, K::Tray, K::Tower});
+  only_for("yaw_deg", {K::Box, K::Tray, K::Backboard, K::Tower, K::Cup});
+  only_for("thickness", {K::Tray, K::Backboard, K::Tower, K::Cup});
+  only_for("width", {K::Backboard});
+  only_for("height", {K::Backboard, K::Cup});
+  only_for("pyramid_base", {K::Backboard});
+  only_for("pyramid_height", {K::Backboard});
+  only_for("pyramid_pitch", {K::Backboard});
+  only_for("baffles", {K::Tower});
+  only_for("baffle_angle_deg", {K::Tower});
+  only_for("baffle_reach", {K::Tower});
+  only_for("exit_height", {K::Tower});
+  only_for("radius", {K::Cup});
+  only_for("sides", {K::Cup});
+
+  def.material = material_ref(o, materials);
+  auto required = [&](std::string_view key, const std::string& what) {
+    if (!o.get(key)) o.fail_missing(key, what + " (" + kind_text + ")");
+  };
+  const std::string size_text = "an array of 3 numbers, each" + kEdge.text();
+  switch (kind) {
+    case K::Plane:
+      def.point = o.vec3("point", kPosition, def.point, false);
+      def.normal = o.direction("normal", def.normal, true, "the wall's normal, out of the solid into the free space").normalized();
+      break;
+    case K::Polyhedron: {
+      const toml::node* n = o.get("vertices");
+      const std::string allowed = "an array of at least 4 points [x, y, z] (m), not all in one plane";
+      if (!n) o.fail_missing("vertices", allowed);
+      const auto* a = n->as_array();
+      if (!a || a->size() < 4) o.fail(n, o.path_of("vertices"), "must be " + allowed);
+      for (std::size_t i = 0; i < a->size(); ++i) {
+        const std::string k = o.path_of("vertices") + "[" + std::to_string(i) + "]";
+        const auto* p = a->get(i)->as_array();
+        if (!p || p->size() != 3) o.fail(a->get(i), k, "must be an array of 3 numbers" + kPosition.text());
+        Vec3 v;
+        for (int c = 0; c < 3; ++c) v[c] = o.number(*p->get(c), k + "[" + std::to_string(c) + "]", kPosition);
+        def.vertices.push_back(v);
+      }
+      if (!spans_solid(def.vertices))
+        o.fail(n, o.path_of("vertices"), "must be " + allowed + " (these lie in one plane, on one line or at one point)");
+      break;
+    }
+    case K::Box:
+    case K::Tray:
+    case K::Tower:
+      required("size", kind == K::Box ? "edge lengths: " + size_text
+                       : kind == K::Tray ? "inner length (x), inner width (y), wall height (z): " + size_text
+                                         : "the chute's inner x width, inner y width, height: " + size_text);
+      def.size = o.vec3("size", kEdge, def.size, false);
+      break;
+    case K::Backboard:
+      required("width", "the wall's length along its face, a number" + kEdge.text());
+      def.width = o.number("width", kEdge, def.width);
+      def.height = o.number("height", kEdge, def.height);
+      def.pyramid_base = o.number("pyramid_base", kEdge, def.pyramid_base);
+      def.pyramid_height = o.number("pyramid_height", kEdge, def.pyramid_height);
+      def.pyramid_pitch = o.number("pyramid_pitch", kEdge, def.pyramid_pitch);
+      if (def.pyramid_base > std::min(def.width, def.height))
+        o.fail(o.get("pyramid_base"), o.path_of("pyramid_base"),
+               "must be a number in (0, min(width, height)] = (0, " + num_text(std::min(def.width, def.height)) +
+                   "] m: at least one pyramid must fit on the face");
+      if (def.pyramid_pitch < def.pyramid_base)
+        o.fail(o.get("pyramid_pitch"), o.path_of("pyramid_pitch"),
+               "must be a number >= pyramid_base = " + num_text(def.pyramid_base) + " m (the pyramids must not overlap)");
+      break;
+    case K::Cup:
+      required("radius", "the inner radius (centre to each wall's inner face), a number" + kEdge.text());
+      required("height", "the wall height, a number" + kEdge.text());
+      def.radius = o.number("radius", kEdge, def.radius);
+      def.height = o.number("height", kEdge, def.height);
+      def.sides = o.integer("sides", 3, 360, def.sides);
+      break;
+  }
+  if (kind != K::Plane && kind != K::Polyhedron) {
+    def.centre = o.vec3("centre", kPosition, def.centre, false);
+    def.yaw_deg = o.number("yaw_deg", kYaw, def.yaw_deg);
+  }
+  if (kind == K::Tray || kind == K::Backboard || kind == K::Tower || kind == K::Cup)
+    def.thickness = o.number("thickness", kEdge, def.thickness);
+  if (kind == K::Tower) {
+    def.baffles = o.integer("baffles", 0, 20, def.baffles);
+    def.baffle_angle_deg = o.number("baffle_angle_deg", kBaffleAngle, def.baffle_angle_deg);
+    def.baffle_reach = o.number("baffle_reach", kBaffleReach, def.baffle_reach);
+    def.exit_height = o.number("exit_height", kEdge, def.size.z() / 4.0);
+    if (def.exit_height >= def.size.z())
+      o.fail(o.get("exit_height"), o.path_of("exit_height"),
+             "must be a number in (0, size.z) = (0, " + num_text(def.size.z()) + ") m: the exit is in the tower's foot");
+    const double drop = def.baffle_reach * def.size.x() * std::tan(def.baffle_angle_deg * kPi / 180.0);
+    if (def.baffles > 0 && drop >= def.size.z()) {
+      const char* key = o.get("baffle_angle_deg") ? "baffle_angle_deg" : o.get("baffle_reach") ? "baffle_reach" : "size";
+      o.fail(o.get(key), o.path_of(key),
+             "the baffles do not fit: each drops baffle_reach * size.x * tan(baffle_angle_deg) = " + num_text(drop) +
+                 " m, which must be below the tower's height size.z = " + num_text(def.size.z()) + " m");
+    }
+  }
+  o.finish();
+}
+
+void read_obstacles(Reader& top, SceneDef& s) {
+  std::vector<Reader> entries = top.tables("obstacles");
+  for (Reader& o : entries) {
+    ObstacleDef def;
+    read_obstacle(o, s.materials, def);
+    s.obstacles.push_back(std::move(def));
+  }
 }
 
 void read_sim(Reader sim, SimDef& def) {
@@ -561,7 +791,8 @@ void read_sim(Reader sim, SimDef& def) {
   sim.finish();
 }
 
-SceneDef build(const toml::table& tree, const std::string& origin, const std::string& default_name) {
+SceneDef build(const toml::table& tree, const std::string& origin, const std::string& default_name,
+               std::vector<std::string>* dice_scene_texts) {
   SceneDef s = default_scene_def();
   s.sim.fidelity = Fidelity::Auto;  // a scene file that names no model gets the measured choice (issue 35)
   Reader top(&tree, "", origin);
@@ -569,7 +800,10 @@ SceneDef build(const toml::table& tree, const std::string& origin, const std::st
   if (s.name.empty()) top.fail(top.get("name"), "name", "must be a non-empty string");
   top.get("extends");  // already resolved; listed so that it shows among the allowed keys
   read_materials(top.sub("materials"), s.materials);
-  read_die(top.sub("die"), s.materials, s.die);
+  // [die] may be left out when every [[dice]] entry names a scene of its own.
+  const bool has_die = top.get("die") != nullptr;
+  const bool has_dice = tree.get("dice") != nullptr;
+  if (has_die || !has_dice) read_die(top.sub("die"), s.materials, s.die);
   read_throw(top.sub("throw"), s.throw_);
   read_floor(top.sub("floor"), s.floor);
   read_sim(top.sub("sim"), s.sim);
@@ -580,6 +814,27 @@ SceneDef build(const toml::table& tree, const std::string& origin, const std::st
   if (s.sim.end == EndKind::Floor && s.throw_.catch_time) {
     Reader th = top.sub("throw");
     th.fail(th.get("catch_time"), "throw.catch_time", "applies only to sim.end = \"catch\"");
+  }
+  // Several dice and obstacles (issue 41), read last so that the allowed keys list them last.
+  top.get("dice");
+  if (has_dice) read_dice(top, s, has_die, dice_scene_texts);
+  if (!has_dice) {
+    Reader th = top.sub("throw");
+    if (const toml::node* hand = th.get("hand"))
+      th.fail(hand, "throw.hand", "applies only to a scene with [[dice]] (several dice)");
+  }
+  read_obstacles(top, s);
+  if (!s.obstacles.empty() && s.dice.empty() && s.die.shape == ShapeKind::Cylinder) {
+    Reader die = top.sub("die");
+    die.fail(die.get("shape"), "die.shape",
+             "a curved die (\"cylinder\") with [[obstacles]]: several dice and obstacles: polyhedral dice only");
+  }
+  if (top.get("outcomes")) {
+    Reader outcomes = top.sub("outcomes");
+    if (!has_dice)
+      top.fail(top.get("outcomes"), "outcomes", "applies only to a scene with [[dice]] (several dice): one die's outcome is its face");
+    s.outcomes.kind = outcomes.choice("kind", kOutcomeKinds, s.outcomes.kind).second;
+    outcomes.finish();
   }
   top.finish();
   return s;
@@ -781,16 +1036,43 @@ std::string stem_or(const std::string& path, const std::string& fallback) {
   return stem.empty() ? fallback : stem;
 }
 
-// The resolved tree's hash (scene_hash.hpp); build() validates it and reads a mesh's OBJ.
+// A [[dice]] entry's `scene`, read now (relative to the file the key was written in, with its own
+// `extends`) and validated as a scene of its own; only its [die] and [materials] are used. A scene
+// with [[dice]] cannot be named (no nesting, and so no cycle through `scene`).
+DieSource load_die_scene(Reader& entry) {
+  const toml::node* n = entry.get("scene");
+  const std::string key = entry.path_of("scene");
+  const fs::path written = n->as_string()->get();
+  const fs::path base = n->source().path ? fs::path(*n->source().path).parent_path() : fs::current_path();
+  const fs::path path = written.is_absolute() ? written : (base / written).lexically_normal();
+  if (!fs::is_regular_file(path))
+    entry.fail(n, key, "cannot open scene file '" + path.string() + "' (a scene path relative to the scene file that states the key)");
+  std::vector<ChainLink> chain{{fs::weakly_canonical(path), path}};
+  toml::table tree = load_tree(path, chain);
+  if (tree.get("dice"))
+    entry.fail(n, key, "names a scene with [[dice]]: a [[dice]] entry's scene must be a scene of one die (its [die])");
+  SceneDef def = build(tree, path.string(), stem_or(path.string(), "scene"), nullptr);
+  std::string text = canonical_scene_text(tree, def.die.mesh_text);
+  return {std::move(def.die), std::move(def.materials), std::move(text)};
+}
+
+// The resolved tree's hash (scene_hash.hpp); build() validates it and reads a mesh's OBJ. A [[dice]]
+// entry's `scene` path is replaced by "sha256:" and the hash of that scene's own canonical text (as
+// a mesh's path by its OBJ's): an edited die scene changes the hash, the same one under another
+// path does not.
 std::string tree_sha256(toml::table tree, const std::string& origin, const std::vector<std::string>& overrides) {
   for (const std::string& o : overrides) apply_override(tree, o, origin);
-  const SceneDef def = build(tree, origin, stem_or(origin, "scene"));
+  std::vector<std::string> dice_texts;
+  const SceneDef def = build(tree, origin, stem_or(origin, "scene"), &dice_texts);
+  if (toml::array* dice = tree.get("dice") ? tree.get("dice")->as_array() : nullptr)
+    for (std::size_t i = 0; i < dice_texts.size() && i < dice->size(); ++i)
+      if (!dice_texts[i].empty()) dice->get(i)->as_table()->insert_or_assign("scene", "sha256:" + sha256_hex(dice_texts[i]));
   return sha256_hex(canonical_scene_text(tree, def.die.mesh_text));
 }
 
 SceneDef finish_tree(toml::table tree, const std::string& origin, const std::vector<std::string>& overrides) {
   for (const std::string& o : overrides) apply_override(tree, o, origin);
-  return build(tree, origin, stem_or(origin, "scene"));
+  return build(tree, origin, stem_or(origin, "scene"), nullptr);
 }
 
 }  // namespace
@@ -865,6 +1147,21 @@ std::string key_unit(std::string_view key) {
       {"sim.step", &kStep},
       {"sim.contact_step", &kStep},
       {"sim.contact_tol", &kContactTol},
+      {"dice.offset", &kOffset},
+      {"obstacles.point", &kPosition},
+      {"obstacles.vertices", &kPosition},
+      {"obstacles.centre", &kPosition},
+      {"obstacles.size", &kEdge},
+      {"obstacles.yaw_deg", &kYaw},
+      {"obstacles.thickness", &kEdge},
+      {"obstacles.width", &kEdge},
+      {"obstacles.height", &kEdge},
+      {"obstacles.radius", &kEdge},
+      {"obstacles.pyramid_base", &kEdge},
+      {"obstacles.pyramid_height", &kEdge},
+      {"obstacles.pyramid_pitch", &kEdge},
+      {"obstacles.baffle_angle_deg", &kBaffleAngle},
+      {"obstacles.exit_height", &kEdge},
   };
   for (const auto& [name, range] : units)
     if (k == name) return range->unit;

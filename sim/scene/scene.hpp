@@ -125,6 +125,12 @@ struct SpinDef {
   NormalScalar tilt_deg;     // kind == BodyAxis: angle of the angular velocity from `axis` (deg)
 };
 
+// throw.hand, for a scene with [[dice]]: "each" (every die draws its own throw: release height,
+// velocity, orientation, spin) or "shared" (one hand: the release position and the velocity are
+// drawn once and shared by every die, each die then at its [[dice]] offset from it; each die draws
+// its own orientation and spin).
+enum class HandKind { Each, Shared };
+
 struct ThrowDef {
   OrientationDef orientation;
   NormalScalar height{1.0, 0.2};                                      // COM height above floor (m)
@@ -132,6 +138,7 @@ struct ThrowDef {
   SpinDef spin{SpinKind::Normal, {Vec3::Zero(), Vec3::Constant(18.0)}, {}, Vec3::UnitX(), {}};
   // sim.end = "catch": the time after release at which the die is caught (s), normal(mean, sd).
   std::optional<NormalScalar> catch_time;
+  HandKind hand = HandKind::Each;  // throw.hand ("each" / "shared"); only with [[dice]]
 };
 
 // How a toss ends: on the floor (the fidelity's dynamics), or caught in the hand in mid-flight
@@ -183,6 +190,94 @@ struct SimDef {
   EndKind end = EndKind::Floor; // "floor" or "catch" (needs [throw.catch_time])
 };
 
+// One [[dice]] entry: a die of a toss of several dice (issue 41).
+struct DiceEntryDef {
+  // `scene = "path"` as written: a scene file (relative to the file that states the key, with its
+  // own `extends`) whose [die] this die is; "" (or the key left out): this scene's own [die].
+  std::string scene;
+  // The die: this scene's [die], or the [die] of that scene file.
+  DieDef die;
+  // The materials that die refers to: its scene's [materials] (all of them).
+  std::map<std::string, MaterialDef> materials;
+  // `offset = [x, y, z]` (m), added to the release position of the throw (finite, |offset| <= 1 m).
+  Vec3 offset = Vec3::Zero();
+};
+
+// [outcomes] kind, for a scene with [[dice]]: "tuple" (the dice's labels in entry order, e.g. (3, 5))
+// or "sum" (the sum of the dice's labels, e.g. 8).
+enum class OutcomeKind { Tuple, Sum };
+inline constexpr std::array<const char*, 2> kOutcomeKindNames = {"tuple", "sum"};
+struct OutcomesDef {
+  OutcomeKind kind = OutcomeKind::Tuple;
+};
+
+// [[obstacles]] kind. Every obstacle is static and made of convex pieces (sim/body/obstacles.hpp
+// expands the compositions); the floor z = 0 stays the resting surface and is not an obstacle.
+enum class ObstacleKind { Plane, Polyhedron, Box, Tray, Backboard, Tower, Cup };
+inline constexpr std::array<const char*, 7> kObstacleKindNames = {"plane", "polyhedron", "box", "tray",
+                                                                  "backboard", "tower", "cup"};
+
+// Defaults of a craps backboard's pyramids (kind = "backboard"). No public regulation or maker's
+// sheet found gives the pyramids' size (casinos choose it: F. Scoblete, "Get Yourself a Table",
+// goldentouchcraps.com/scoblete_articles_0025.shtml), so base, height and pitch are NOT cited:
+// plausible values (a base about a casino die's 19 mm edge, half as high, touching). The wall's
+// height is cited: "Below the rail rubber on each inside end of the table is a 6-to-8-inch wide
+// piece of Pyramid Rubber" (newcasinonodepositbonus.co.uk/craps-table-and-equipment.php); 7 in.
+inline constexpr double kPyramidBase = 0.02;     // m, NOT cited
+inline constexpr double kPyramidHeight = 0.01;   // m, NOT cited
+inline constexpr double kPyramidPitch = 0.02;    // m, NOT cited (= base: the pyramids touch)
+inline constexpr double kBackboardHeight = 7.0 * 0.0254;  // m: 7 in, the middle of the cited 6-8 in
+// A dice tower's baffles (kind = "tower"): three ramps alternating sides at 40 deg, within the
+// "three simple internal ramps at roughly 35 to 45 degrees" of a hobbyist's guide
+// (visualfoodie.com/unique-and-creative-dice-tower-design-ideas); a typical design, not a standard.
+inline constexpr int kTowerBaffles = 3;
+inline constexpr double kTowerBaffleAngleDeg = 40.0;
+inline constexpr double kTowerBaffleReach = 0.6;  // fraction of the chute's inner x width (NOT cited)
+
+// One [[obstacles]] entry. Lengths in m, angles in degrees. "Local" axes are the obstacle's before
+// `yaw_deg` turns it about the vertical through `centre`.
+struct ObstacleDef {
+  ObstacleKind kind = ObstacleKind::Plane;
+  // Required: a [materials] key; its restitution and friction are the obstacle's against a die
+  // (density and the rolling/pivoting resistances are unused).
+  std::string material;
+  // plane: the solid is {x : normal . x <= normal . point}; `normal` (stored unit, not zero) points
+  // out of the wall into the free space.
+  Vec3 point = Vec3::Zero(), normal = Vec3::UnitZ();
+  // polyhedron: world corners (m); their convex hull is the obstacle (>= 4, not all in one plane).
+  std::vector<Vec3> vertices;
+  // box: its centre. tray, backboard, tower, cup: the middle of its foot (the floor is z = 0, so
+  // centre z = 0 stands it on the floor); backboard: the middle of the foot of the face that
+  // carries the pyramids.
+  Vec3 centre = Vec3::Zero();
+  // box: edge lengths (local x, y, z). tray: inner length (x), inner width (y), wall height (z).
+  // tower: the chute's inner x and y widths and its height (z). Unused by the other kinds.
+  Vec3 size = Vec3::Zero();
+  double yaw_deg = 0.0;        // rotation about +z of the whole obstacle (box, tray, backboard, tower, cup)
+  // tray, tower, cup: the walls' thickness (tower: also the baffles'); backboard: the board's behind
+  // the pyramids (m), > 0.
+  double thickness = 0.01;
+  // backboard: the wall's length along its face (local y) and height (z); the pyramids cover the
+  // face in a centred grid. cup: `height` is the wall height.
+  double width = 0.0;
+  double height = kBackboardHeight;
+  double pyramid_base = kPyramidBase;      // backboard: edge of each pyramid's square base (on the face)
+  double pyramid_height = kPyramidHeight;  // backboard: apex height above the face (toward local -x)
+  double pyramid_pitch = kPyramidPitch;    // backboard: centre-to-centre spacing, along y and z (>= base)
+  // tower: `baffles` inclined plates alternating sides (the lowest hangs from the -x wall and slopes
+  // down toward the exit in the +x wall), each `baffle_angle_deg` below horizontal, covering
+  // `baffle_reach` of the inner x width; the exit: an opening `exit_height` high at the foot of the
+  // +x wall, the full inner y width wide.
+  int baffles = kTowerBaffles;
+  double baffle_angle_deg = kTowerBaffleAngleDeg;
+  double baffle_reach = kTowerBaffleReach;
+  double exit_height = 0.0;    // tower: read as size.z / 4 when the scene leaves it out
+  // cup: a regular `sides`-gon ring of wall boxes; `radius` is the inner apothem (centre to each
+  // wall's inner face), `height` the wall height.
+  double radius = 0.0;
+  int sides = 12;
+};
+
 struct SceneDef {
   std::string name;
   std::map<std::string, MaterialDef> materials;
@@ -190,6 +285,12 @@ struct SceneDef {
   ThrowDef throw_;
   FloorDef floor;
   SimDef sim;
+  // [[dice]]: 2 to 6 dice tossed together; empty: one die, `die`. A scene whose [[dice]] entries
+  // all name other scenes may leave out [die]: `die` is then the first entry's die and `materials`
+  // gains that die's materials.
+  std::vector<DiceEntryDef> dice;
+  std::vector<ObstacleDef> obstacles;  // [[obstacles]]: static obstacles
+  OutcomesDef outcomes;                // [outcomes]: only with [[dice]]
 };
 
 // The one place that lists every option's default (as the member initialisers above).

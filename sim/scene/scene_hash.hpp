@@ -6,8 +6,9 @@
 // every number (TOML integer or float) written as an IEEE double in shortest round-trip form, so
 // 2000, 2000.0 and 2e3 are one value; a mesh die's `die.mesh` path replaced by "sha256:" and the
 // hash of the OBJ file's bytes (the same mesh under another path is the same scene; an edited
-// mesh is not). Comments, whitespace, key order, quoting and how a table is written (dotted keys,
-// [headers], inline) leave no trace. A key stated at its default value is not the same text as
+// mesh is not); likewise each [[dice]] entry's `scene` path by "sha256:" and the hash of that
+// scene's own canonical text (tree_sha256 in scene.cpp). Comments, whitespace, key order, quoting
+// and how a table is written (dotted keys, [headers], inline) leave no trace. A key stated at its default value is not the same text as
 // the key left out: those hash differently.
 #pragma once
 

@@ -89,6 +89,11 @@ AutoPrecision precision_of_target(const DieModel& m, double halfwidth) {
 FidelityPilot resolve_auto(DieModel& m, const AutoPrecision& precision, int threads) {
   FidelityPilot pl;
   if (m.fidelity_requested != Fidelity::Auto) return pl;
+  if (m.world) {  // several dice or obstacles: no cheaper model strikes one body against another
+    m.fidelity = Fidelity::Impulse;
+    m.fidelity_reason = "auto: `impulse`: several dice or obstacles, which only `impulse` strikes against each other (no pilot)";
+    return pl;
+  }
   const auto t0 = std::chrono::steady_clock::now();
   pl.ran = true;
   pl.halfwidth = precision.halfwidth;

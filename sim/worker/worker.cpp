@@ -271,7 +271,7 @@ bool WorkerCore::step(double now) {
       b.located_capped.push_back(static_cast<std::int32_t>(r.corrections.located_capped));
       b.support_search_capped.push_back(static_cast<std::int32_t>(r.corrections.support_search_capped));
       b.rise_dropped.push_back(static_cast<std::int32_t>(r.corrections.rise_dropped));
-      b.depth_held.push_back(static_cast<std::int32_t>(r.corrections.depth_held));
+      b.contact_overlaps.push_back(static_cast<std::int32_t>(r.corrections.contact_overlaps));
       b.nudges.push_back(static_cast<std::int32_t>(r.corrections.nudges));
     }
     for (const BounceRecord& rec : records) {
