@@ -31,9 +31,12 @@ namespace dicesim {
 namespace {
 
 constexpr int kMaxDice = 6;
-// Interaction contacts in one toss beyond which it is unresolved: a die leaning on a wall or on
-// another die (cocked) is held by a plastic contact every window and never rests on a face.
-constexpr int kMaxInteractions = 4000;
+// A die held still off its rest (leaning on a wall or another die, cocked; lying on an obstacle's
+// top) never rests on a face by the floor's rule: held this long, kinetic energy below
+// kStillEnergy m g r, the toss is unresolved. A safety cap on contacts besides.
+constexpr double kStillTime = 0.5;      // s
+constexpr double kStillEnergy = 1e-4;   // of m g r
+constexpr int kMaxInteractions = 200000;
 
 // A contact between die i and something else at one instant.
 struct Touch {
@@ -295,6 +298,8 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
 
   double T = 0.0;
   int interactions = 0;
+  std::array<double, kMaxDice> still_since;  // per die: since when it has been held still off its rest (-1: moving)
+  still_since.fill(-1.0);
   std::uint64_t windows = 0;
   bool unresolved = false;
   std::array<Reach, kMaxDice> reach{};
@@ -304,7 +309,14 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
       const ImpulseRun& r = runs[static_cast<std::size_t>(k)];
       reach[static_cast<std::size_t>(k)] = reach_of(r);
       any_running = any_running || r.state == RunState::Running;
+      double& since = still_since[static_cast<std::size_t>(k)];
+      const bool still = r.state == RunState::Running &&
+                         kinetic_energy(*r.m, r.s) < kStillEnergy * r.m->mass * r.m->gravity * r.m->bounding_radius;
+      if (!still) since = -1.0;
+      else if (since < 0.0) since = T;
+      else if (T - since > kStillTime) unresolved = true;
     }
+    if (unresolved) break;
     if (!any_running) break;
     if (T >= m.max_time) {
       unresolved = true;
