@@ -32,6 +32,8 @@ struct ShowPage {
 
 ShowPage show(Scene& scene, std::optional<std::uint64_t> toss, std::uint64_t seed, std::optional<std::string> fidelity) {
   const std::shared_ptr<const DieModel> model = scene.model(fidelity);
+  if (model->world)
+    throw pb::value_error("show draws one die alone: a toss of several dice or among obstacles cannot be drawn yet (docs/world.md)");
   nlohmann::json page;
   page["scene"] = scene.origin();
   page["die"] = web::die_json(*model, scene.def());
