@@ -219,7 +219,7 @@ fidelity = "impulse"
 // little scatter. The mutual information between the face set up (each of the six, equally often)
 // and the first die's face read, without the backboard and with it. Plug-in estimates with the
 // Miller-Madow correction (the plug-in's bias, (6 - 1)^2 / (2 N ln 2) = 0.020 bits at N = 900,
-// subtracted). Measured at seed 1: 0.091 bits without, 0.018 with. The assertions leave a margin of
+// subtracted). Measured at seed 1: 0.087 bits without, 0.017 with. The assertions leave a margin of
 // several standard errors of such an estimate (~0.01 bits here).
 double mutual_information_bits(const std::array<std::array<double, 6>, 6>& n) {
   double total = 0.0;

@@ -210,6 +210,23 @@ double fastest_corner(const DieModel& d, const RigidState& s, const Vec3& dir) {
   return fastest;
 }
 
+// How soon a corner of the die, at its speed now plus `extra` toward the plane {x : n . x = level}
+// (n pointing into the die), would reach it: min over corners of height / approach (+inf if none
+// approaches). A far corner approaching fast does not shorten it as a near one does.
+double closing_time(const DieModel& d, const RigidState& s, const Vec3& n, double level, double extra) {
+  const Vec3 spin_dir = s.omega.cross(n);
+  const double along = s.velocity.dot(n);
+  double soonest = std::numeric_limits<double>::infinity();
+  for (const Vec3& c : d.vertices) {
+    const Vec3 r = s.R * c;
+    const double approach = -(along - r.dot(spin_dir)) + extra;
+    if (approach <= 0.0) continue;
+    const double height = std::max(0.0, n.dot(s.position + r) - d.rounding - level);
+    soonest = std::min(soonest, height / approach);
+  }
+  return soonest;
+}
+
 Vec3 point_velocity(const RigidState& s, const Vec3& x) { return s.velocity + s.omega.cross(x - s.position); }
 
 Mat3 inverse_inertia(const DieModel& d, const Mat3& R) {
@@ -326,8 +343,9 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     // The window: as long as no pair can close its gap; pairs touching now are struck first.
     double window = m.max_time - T;
     bool struck = false;
-    // safe(gap): the longest window the pair's bounds allow for that gap; approach(): how fast the
-    // pair's nearest points close now; strike(): strikes the pair if it approaches (true).
+    // safe(gap): the longest window the pair's bounds allow for that gap; approach(): how soon the
+    // pair's corners, at their speeds now, would close it; strike(): strikes the pair if it
+    // approaches (true).
     // A window longer than a pair's bound allows (nearly touching, below) is checked afterwards.
     risky_n = 0;
     const auto risky = [&](int i, int j, int p, double gap) {
@@ -340,12 +358,10 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
       if (t.gap > tol) {
         double dt = safe(t.gap);
         if (t.gap < near) {
-          // Near: half what the pair's fastest corners now take to close the gap, at most t_guess,
-          // and never so long that the bound could carry one body through half the other. Checked
-          // after the window (and located by halving if it went deeper than the sink).
-          const double a = approach();
-          double guess = a > v_still ? t.gap / (2.0 * a) : t_guess;
-          guess = std::min({guess, t_guess, (t.gap + 0.5 * thick) / closing});
+          // Near: half what the pair's corners at their speeds now take to close the gap, at most
+          // t_guess, and never so long that the bound could carry one body through half the other.
+          // Checked after the window (and located by halving if it went deeper than the sink).
+          const double guess = std::min({0.5 * approach(), t_guess, (t.gap + 0.5 * thick) / closing});
           if (guess > dt) {
             dt = guess;
             risky(i, j, p, t.gap);
@@ -383,7 +399,8 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
           }
           return dt;
         };
-        const auto approach = [&] { return fastest_corner(di, ri.s, -t.normal); };
+        // The other surface's plane at the touch: n . x = n . point - gap.
+        const auto approach = [&] { return closing_time(di, ri.s, t.normal, t.normal.dot(t.point) - t.gap, 0.0); };
         consider(t, safe, approach, [&] {
           const double un = point_velocity(ri.s, t.point).dot(t.normal);
           if (!(un < -v_still)) {
@@ -431,7 +448,12 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
           return dt;
         };
         const auto approach = [&] {
-          return fastest_corner(di, ri.s, -t.normal) + fastest_corner(*rj.m, rj.s, t.normal);
+          // Each die's corners against the other's surface plane, the other closing at its fastest.
+          // (t.point is midway between the two surfaces.)
+          const double level_j = t.normal.dot(t.point) - 0.5 * t.gap;     // j's surface, seen from i
+          const double level_i = -(t.normal.dot(t.point) + 0.5 * t.gap);  // i's surface, seen from j (normal -n)
+          return std::min(closing_time(di, ri.s, t.normal, level_j, fastest_corner(*rj.m, rj.s, t.normal)),
+                          closing_time(*rj.m, rj.s, -t.normal, level_i, fastest_corner(di, ri.s, -t.normal)));
         };
         consider(t, safe, approach, [&] {
           const double un = (point_velocity(ri.s, t.point) - point_velocity(rj.s, t.point)).dot(t.normal);
