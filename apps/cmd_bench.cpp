@@ -150,6 +150,17 @@ nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
           {"sink_shortened_per_toss", static_cast<double>(probe.sink_shortened) / np},
           {"short_steps_per_toss", static_cast<double>(probe.short_steps) / np},
           {"rise_dropped_per_toss", static_cast<double>(probe.rise_dropped) / np},
+          // Several dice and obstacles (docs/world.md): windows of conservative advancement, those
+          // taken again at half length (a near pair went too deep), contacts struck between
+          // bodies, dice struck at rest and moving again, strikes of an obstacle's nearest point
+          // after its corners', narrow-phase calls at their iteration cap, the deepest overlap.
+          {"world_windows_per_toss", static_cast<double>(probe.windows) / np},
+          {"world_windows_halved_per_toss", static_cast<double>(probe.windows_halved) / np},
+          {"world_interactions_per_toss", static_cast<double>(probe.interactions) / np},
+          {"world_woken_per_toss", static_cast<double>(probe.woken) / np},
+          {"world_witness_strikes", probe.witness_strikes},
+          {"world_narrow_degenerate", probe.narrow_degenerate},
+          {"world_max_overlap_m", probe.max_overlap},
           {"timed_tosses", n_probe},
           {"timed_tosses_per_s", np / probe_total},
           {"phases", phases},

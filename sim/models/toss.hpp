@@ -103,6 +103,7 @@ struct TossProbe {
   std::uint64_t interactions = 0;
   std::uint64_t woken = 0;
   std::uint64_t narrow_degenerate = 0;
+  std::uint64_t witness_strikes = 0;  // die-on-obstacle strikes whose nearest point, still approaching after its corners', was struck too
   double max_overlap = 0.0;  // the deepest overlap of two bodies found after a window (m), lifted out
                              // (beyond 1e-4 r also counted: Corrections::contact_overlaps)
   RigidState* final_state = nullptr;           // impulse, stepped: the state when the toss ended

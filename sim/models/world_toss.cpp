@@ -160,8 +160,9 @@ Mat3 to_normal_frame(const Vec3& n) { return Quat::FromTwoVectors(n, Vec3::UnitZ
 // Die k against a fixed piece at a touch: the floor's law turned to the piece's face. Every corner
 // of the die within `tol` of the piece strikes together; if none (an edge across an edge, a
 // pyramid's tip on a face), the one witness point.
+// `witness` counts the nearest point's own strike when the corners' left it approaching.
 ImpactResult strike_piece(const World& w, int k, RigidState& s, const ObstaclePiece& p, int material, const Touch& t,
-                          double tol, bool restitution) {
+                          double tol, bool restitution, std::uint64_t& witness) {
   const DieModel& d = w.die_against[static_cast<std::size_t>(k)][static_cast<std::size_t>(material)];
   ContactSet c;
   std::array<Vec3, kMaxContacts> r{};
@@ -195,6 +196,7 @@ ImpactResult strike_piece(const World& w, int k, RigidState& s, const ObstaclePi
     imp.corrections.add(more.corrections);
     imp.normal_impulse += more.normal_impulse;
     imp.energy_after = more.energy_after;
+    ++witness;
   }
   s.velocity = Q.transpose() * q.velocity;
   s.omega = Q.transpose() * q.omega;
@@ -315,6 +317,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
 
   double T = 0.0;
   int interactions = 0;
+  std::uint64_t witness_strikes = 0;
   std::array<double, kMaxDice> still_since;  // per die: since when it has been held still off its rest (-1: moving)
   still_since.fill(-1.0);
   std::uint64_t windows = 0;
@@ -410,7 +413,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
             return true;
           }
           const bool bounce = -un > v_slow;
-          const ImpactResult imp = strike_piece(w, i, ri.s, piece, w.piece_material[p], t, tol, bounce);
+          const ImpactResult imp = strike_piece(w, i, ri.s, piece, w.piece_material[p], t, tol, bounce, witness_strikes);
           ri.corrections.add(imp.corrections);
           if (t.gap < -tol) {  // found overlapping: struck, and lifted out along the normal
             overlap_found(ri, t.gap);
@@ -529,7 +532,10 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     for (const ImpulseRun& r : runs)
       if (r.state == RunState::Unresolved) unresolved = true;
   }
-  if (probe) probe->windows += windows;
+  if (probe) {
+    probe->windows += windows;
+    probe->witness_strikes += witness_strikes;
+  }
 
   // The toss's result from every die's.
   int tuple = 0;
