@@ -5,6 +5,7 @@
 // separating-plane certificate; overlaps against sampled directions and the translation that should
 // just separate them.
 #include "sim/dynamics/convex_distance.hpp"
+#include "tests/random_geometry.hpp"
 
 #include <gtest/gtest.h>
 
@@ -88,14 +89,8 @@ Mat3 turn(const Vec3& from, const Vec3& to) {
   return Eigen::Quaterniond::FromTwoVectors(from, to).toRotationMatrix();
 }
 
-Mat3 random_rotation(std::mt19937_64& rng) {
-  std::normal_distribution<double> g;
-  return Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
-}
-Vec3 random_unit(std::mt19937_64& rng) {
-  std::normal_distribution<double> g;
-  return Vec3(g(rng), g(rng), g(rng)).normalized();
-}
+using testing::random_rotation;
+using testing::random_unit;
 
 std::vector<Vec3> world_corners(const PlacedHull& h) {
   std::vector<Vec3> out;

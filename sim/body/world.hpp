@@ -7,6 +7,7 @@
 
 #include "sim/body/die_model.hpp"
 #include "sim/body/obstacles.hpp"
+#include "sim/body/piece_tree.hpp"
 #include "sim/scene/scene.hpp"
 
 namespace dicesim {
@@ -22,11 +23,15 @@ struct World {
 
   std::vector<ObstaclePiece> pieces;   // the obstacles, convex pieces
   std::vector<Vec3> piece_lo, piece_hi;  // per piece: its axis-aligned bounding box (polyhedra; planes: unused)
+  PieceTree piece_tree;                // the polyhedra's boxes, for the pieces near a die (planes: not in it)
+  std::vector<int> plane_pieces;       // the half-space pieces (not in the tree)
   std::vector<double> piece_width;     // per piece: its least width across its faces (planes: +inf)
   std::vector<int> piece_material;     // per piece: index into die_against's second level
   // [die][material]: the die with that obstacle material's restitution and friction at every corner
   // (the floor law, turned to the obstacle's face, reads its materials from the model).
   std::vector<std::vector<DieModel>> die_against;
+  // [die i][die j]: die_against's material for i struck against j held at rest (the two dice's means).
+  std::vector<std::vector<int>> die_pair_material;
 
   // The toss's outcome from the dice's: tuple index = sum_k outcome_k * stride[k] (mixed radix, the
   // first die most significant: ascending tuple labels), then tuple_outcome[tuple index].

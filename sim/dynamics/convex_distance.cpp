@@ -246,22 +246,58 @@ void overlap_by_sat(const PlacedHull& a, const PlacedHull& b, const Pair& p, Sep
   out.point_b = b.R * p.cb[ib] + b.x;
 }
 
+// Keeps the first `count` vertices of s that carry weight in c (the sub-simplex nearest the
+// origin), in order, with their weights; returns how many.
+int keep_support(Simplex& s, std::array<double, 4>& lambda, const Closest& c, int count) {
+  int m = 0;
+  for (int q = 0; q < count; ++q)
+    if (c.lambda[q] > 0.0) {
+      s[m] = s[q];
+      lambda[m] = c.lambda[q];
+      ++m;
+    }
+  return m;
+}
+
 }  // namespace
 
-Separation separation(const PlacedHull& a, const PlacedHull& b) {
+Separation separation(const PlacedHull& a, const PlacedHull& b, SeparationCache* cache) {
   const Mat3 RaT = a.R.transpose();
   const Pair p{a.corners, b.corners, RaT * b.R, RaT * (b.x - a.x)};
   Separation out;
 
-  // Start from the support toward B's origin: the side of A - B that faces the origin.
+  // Start from the support toward B's origin: the side of A - B that faces the origin; or from
+  // the cached simplex's corners where the hulls are now, reduced to its part nearest the origin.
   Simplex s;
   int n = 1;
   std::array<double, 4> lambda{1.0, 0.0, 0.0, 0.0};
-  s[0] = support(p, p.xb.squaredNorm() > 0.0 ? p.xb : Vec3::UnitX());
-  Vec3 v = s[0].w;
-  double v2 = v.squaredNorm();
-  double max_w2 = v2;
-  bool overlap = v2 == 0.0;
+  Vec3 v;
+  double v2;
+  if (cache && cache->n > 0) {
+    n = cache->n;
+    for (int q = 0; q < n; ++q) {
+      const int ia = cache->ia[q], ib = cache->ib[q];
+      s[q] = {p.ca[ia] - (mul(p.Rb, p.cb[ib]) + p.xb), ia, ib};
+    }
+    Closest c;
+    if (n == 1) {
+      c.lambda[0] = 1.0;
+      c.v = s[0].w;
+      c.v2 = c.v.squaredNorm();
+    } else {
+      c = n == 2 ? closest_segment(s, 0, 1) : closest_triangle(s, 0, 1, 2);
+    }
+    n = keep_support(s, lambda, c, n);
+    v = c.v;
+    v2 = c.v2;
+  } else {
+    s[0] = support(p, p.xb.squaredNorm() > 0.0 ? p.xb : Vec3::UnitX());
+    v = s[0].w;
+    v2 = v.squaredNorm();
+  }
+  double max_w2 = 0.0;
+  for (int q = 0; q < n; ++q) max_w2 = std::max(max_w2, s[q].w.squaredNorm());
+  bool overlap = v2 == 0.0 || (n > 1 && v2 <= kTouching2 * max_w2);
   bool converged = false;
 
   while (!overlap && out.iterations < kMaxIterations) {
@@ -289,20 +325,20 @@ Separation separation(const PlacedHull& a, const PlacedHull& b) {
       converged = true;
       break;
     }
-    int m = 0;
-    for (int q = 0; q <= n; ++q)
-      if (c.lambda[q] > 0.0) {
-        s[m] = s[q];
-        lambda[m] = c.lambda[q];
-        ++m;
-      }
-    n = m;
+    n = keep_support(s, lambda, c, n + 1);
     v = c.v;
     v2 = c.v2;
     if (v2 <= kTouching2 * max_w2) overlap = true;
   }
   if (!overlap && !converged) out.degenerate = true;  // the cap
 
+  if (cache) {
+    cache->n = overlap ? 0 : n;
+    for (int q = 0; q < cache->n; ++q) {
+      cache->ia[q] = s[q].ia;
+      cache->ib[q] = s[q].ib;
+    }
+  }
   if (overlap) {
     overlap_by_sat(a, b, p, out);
     return out;

@@ -4,6 +4,7 @@
 // needs the distance, which libccd does not give.
 #pragma once
 
+#include <array>
 #include <span>
 
 #include "sim/math.hpp"
@@ -41,7 +42,16 @@ struct Separation {
   bool sat = false;         // the answer is the SAT's (overlap, or touching within GJK's tolerance)
 };
 
-Separation separation(const PlacedHull& a, const PlacedHull& b);
+// The corners of the simplex a separated pair ended with, to start the same pair's next call from
+// (a warm start: a pair that moved a little since converges in an iteration or two instead of
+// five or six). n = 0: none (a cold start from the support toward B).
+struct SeparationCache {
+  std::array<int, 3> ia{}, ib{};
+  int n = 0;
+};
+
+// `cache` (optional) is read to start from and written with the final simplex (n = 0 if overlapping).
+Separation separation(const PlacedHull& a, const PlacedHull& b, SeparationCache* cache = nullptr);
 
 // Distance from a world point to a placed hull (>0 outside, <=0 inside: minus the depth to the
 // nearest face) and the closest point (inside: the point's projection onto that face's plane).

@@ -32,14 +32,14 @@ bool slips_past_cone(const Body& b, const Points& pts) {
 }  // namespace friction_detail
 
 ImpactResult apply_friction_impact_at(const DieModel& m, RigidState& s, const ContactSet& c, const Vec3* r,
-                                      bool restitution) {
+                                      bool restitution, const ContactImpulses* warm, ContactImpulses* out) {
   using namespace friction_detail;
   using friction_detail::Body;
   // (Body's own initialisation from the product, as apply_friction_impact's set-up has it.)
   const Body b0{m.mass, 1.0 / m.mass, s.R * m.principal_moments.cwiseInverse().asDiagonal() * s.R.transpose(), &s};
   ContactGeometry geo;
   set_up_geometry(m, b0, s.R, c, geo, r);
-  return apply_friction_impact(m, s, c, restitution, nullptr, nullptr, &geo);
+  return apply_friction_impact(m, s, c, restitution, warm, out, &geo);
 }
 
 ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const ContactSet& c, bool restitution,

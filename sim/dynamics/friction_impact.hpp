@@ -133,9 +133,10 @@ ImpactResult apply_friction_impact(const DieModel& m, RigidState& s, const Conta
 
 // The same impact law at given contact points: r[i] the lever arm (world, from the COM) of point i,
 // c.vertex[i] the feature whose materials it has (a cylinder's rim points between its features:
-// FixedStepper's rim strike).
+// FixedStepper's rim strike). `warm` and `out` as apply_friction_impact's (matched by c.vertex).
 ImpactResult apply_friction_impact_at(const DieModel& m, RigidState& s, const ContactSet& c, const Vec3* r,
-                                      bool restitution);
+                                      bool restitution, const ContactImpulses* warm = nullptr,
+                                      ContactImpulses* out = nullptr);
 
 // The one-corner plastic sliding impulse P = lambda (mu d, 1) (d a unit friction direction):
 // zero final normal velocity u + W P, final slip anti-parallel to d. W the point's compliance, u

@@ -47,41 +47,30 @@ void ImpulseRun::advance(double t_stop, TossProbe* probe) {
       sustained = false;  // lift-off: back to exact flight
       s.R = Quat(s.R).normalized().toRotationMatrix();
     }
-    int down;
-    {
-      const PhaseTimer timer(probe, Phase::Rest);
-      down = rest_face_down(md, s, tiebreak);
-    }
-    if (down >= 0) return settle(down);
+    if (!flight && settles_now(probe)) return;
     if (t >= t_stop) return;
-
     PhaseTimer search_timer(probe, Phase::Search);  // flight, contact search and contact set
-    const Flight flight(md, s);
-    const double t_limit = std::min(md.max_time, t_stop);
-    const ContactSearch c = flight.next_contact(t_limit - t);
-    if (probe) {
-      probe->search_iterations += static_cast<std::uint64_t>(c.iterations);
-      ++probe->flights;
+    if (!flight) start_flight(probe);
+    const ContactSearch& c = flight->contact;
+    if (flight->t0 + c.t > t_stop) {
+      // The window ends in flight: the exact state there; the flight goes on from its own start.
+      s = flight->path.state(t_stop - flight->t0);
+      t = t_stop;
+      return;
     }
     if (c.outcome != ContactSearch::Outcome::Contact) {
-      if (t_stop < md.max_time && c.outcome == ContactSearch::Outcome::TimeLimit) {
-        // The window ends in flight: the exact state there, the flight picked up from it.
-        s = flight.state(t_stop - t);
-        s.R = Quat(s.R).normalized().toRotationMatrix();
-        since_impact += t_stop - t;
-        t = t_stop;
-        return;
-      }
-      t += c.t;
+      t = flight->t0 + c.t;
       return unresolved();
     }
     RigidState at = c.at;  // = flight.state(c.t): the search evaluated the rotation there already
     at.R = Quat(at.R).normalized().toRotationMatrix();
+    const double t_contact = flight->t0 + c.t, flown = c.t;
+    flight.reset();
     const ContactSet set = touching_corners(md, at, set_tol);
     // A slow re-landing within one contact step is sustained contact: the stepper takes over from
     // the state after the impact. (The one search from that state decides it and, if not, is the
     // next flight's.)
-    if (after_impact && since_impact + c.t <= md.contact_step) {
+    if (after_impact && since_impact + flown <= md.contact_step) {
       double approach = 0.0;
       for (int i = 0; i < set.n; ++i) approach = std::min(approach, corner_velocity(md, at, set.vertex[i]).z());
       if (-approach <= v_sustained) {
@@ -94,7 +83,7 @@ void ImpulseRun::advance(double t_stop, TossProbe* probe) {
     const PhaseTimer impact_timer(probe, Phase::Impact);
     after_impact = false;
     since_impact = 0.0;
-    t += c.t;
+    t = t_contact;
     s = at;
     const RigidState before = s;
     const ImpactResult imp = apply_friction_impact(md, s, set, /*restitution=*/true);
@@ -112,6 +101,27 @@ void ImpulseRun::advance(double t_stop, TossProbe* probe) {
     }
     if (bounces >= md.max_bounces) return unresolved();
     after_impact = true;
+  }
+}
+
+bool ImpulseRun::settles_now(TossProbe* probe) {
+  int down;
+  {
+    const PhaseTimer timer(probe, Phase::Rest);
+    down = rest_face_down(*m, s, tiebreak);
+  }
+  if (down < 0) return false;
+  face_down = down;
+  state = RunState::Settled;
+  return true;
+}
+
+void ImpulseRun::start_flight(TossProbe* probe) {
+  flight.emplace(FlightAhead{Flight(*m, s), t, {}});
+  flight->contact = flight->path.next_contact(m->max_time - t);
+  if (probe) {
+    probe->search_iterations += static_cast<std::uint64_t>(flight->contact.iterations);
+    ++probe->flights;
   }
 }
 

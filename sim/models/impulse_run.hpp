@@ -5,14 +5,24 @@
 #pragma once
 
 #include <limits>
+#include <optional>
 
 #include "sim/body/die_model.hpp"
 #include "sim/dynamics/contact_stepper.hpp"
+#include "sim/dynamics/flight.hpp"
 #include "sim/models/toss.hpp"
 
 namespace dicesim {
 
 enum class RunState : std::uint8_t { Running, Settled, Unresolved };
+
+// A flight in progress: where it started and its next floor contact, searched once for the whole
+// flight (a window that ends in flight evaluates the same flight there and picks it up again).
+struct FlightAhead {
+  Flight path;
+  double t0 = 0.0;         // the toss time at its start
+  ContactSearch contact;   // times relative to t0
+};
 
 struct ImpulseRun {
   const DieModel* m = nullptr;
@@ -25,6 +35,7 @@ struct ImpulseRun {
   double since_impact = 0.0;  // time from that impact to the current flight's start (a window cut the flight)
   RunState state = RunState::Running;
   int face_down = -1;         // Settled: the face on the floor
+  std::optional<FlightAhead> flight;  // set while flying (not sustained, not at rest)
   StepperStats stats;
   Corrections corrections;    // the impacts' own (the stepper's are in stats)
 
@@ -33,6 +44,14 @@ struct ImpulseRun {
   // Advances until t_stop (exactly: a flight is evaluated there, a sustained phase's last step is
   // shortened to end there), rest or a cap.
   void advance(double t_stop, TossProbe* probe);
+
+  // The rest check every flight's start makes: true (and settled) if the die rests here.
+  bool settles_now(TossProbe* probe);
+  // Starts the flight from s at t, its contact searched to max_time (untimed: the caller's phase).
+  void start_flight(TossProbe* probe);
+
+  // s was changed from outside (a world toss's strike): the flight in progress, if any, is gone.
+  void moved() { flight.reset(); }
 
   // The TossResult of a run that has ended, its statistics added to the probe.
   TossResult result(TossProbe* probe);

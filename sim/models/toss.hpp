@@ -102,6 +102,8 @@ struct TossProbe {
   std::uint64_t windows_halved = 0;  // ... taken again half as long (a nearly touching pair went too deep)
   std::uint64_t interactions = 0;
   std::uint64_t woken = 0;
+  std::uint64_t sweeps_capped = 0;  // instants whose strikes reached their cap, slow contacts left touching
+  std::uint64_t held_at_rest = 0;  // slow die-on-die strikes against a die at rest, that die held where it lies
   std::uint64_t narrow_degenerate = 0;
   std::uint64_t witness_strikes = 0;  // die-on-obstacle strikes whose nearest point, still approaching after its corners', was struck too
   double max_overlap = 0.0;  // the deepest overlap of two bodies found after a window (m), lifted out

@@ -184,6 +184,23 @@ DieModel compile_world(const SceneDef& scene, const std::string& origin) {
     w->piece_hi.push_back(hi);
     w->piece_width.push_back(width);
   }
+  std::vector<int> polyhedra;
+  for (std::size_t p = 0; p < w->pieces.size(); ++p)
+    if (!w->pieces[p].plane) polyhedra.push_back(static_cast<int>(p));
+  w->piece_tree = PieceTree(w->piece_lo, w->piece_hi, polyhedra);
+  for (std::size_t p = 0; p < w->pieces.size(); ++p)
+    if (w->pieces[p].plane) w->plane_pieces.push_back(static_cast<int>(p));
+  // Die i against die j held at rest (world_toss.cpp): the two dice's mean restitution and friction.
+  const std::size_t n = w->dice.size();
+  w->die_pair_material.assign(n, std::vector<int>(n, -1));
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::pair<double, double> mat{0.5 * (w->die_restitution[i] + w->die_restitution[j]),
+                                          0.5 * (w->die_friction[i] + w->die_friction[j])};
+      auto it = std::find(materials.begin(), materials.end(), mat);
+      if (it == materials.end()) it = materials.insert(materials.end(), mat);
+      w->die_pair_material[i][j] = static_cast<int>(it - materials.begin());
+    }
   for (const DieModel& d : w->dice) {
     std::vector<DieModel> against;
     for (const auto& [e, mu] : materials) {
