@@ -43,7 +43,7 @@ constexpr double kStillTime = 0.5;      // s
 constexpr double kStillEnergy = 1e-4;   // of m g r
 constexpr int kMaxInteractions = 200000;
 // Strikes at one instant are Gauss-Seidel sweeps over the contacts there (see run_world): their cap.
-constexpr int kMaxSweeps = 32;
+constexpr int kMaxSweeps = 16;
 
 // A contact between die i and something else at one instant.
 struct Touch {
@@ -390,12 +390,14 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   // that had to be halved: a die lying on an obstacle's top or on another die waits in windows as
   // long as its checks allow.
   const double t_touching = 0.05 * step;
-  // Approaching: faster than rounding (a plastic strike leaves the point at -1e-17 m/s or so).
-  const double v_still = 1e-9 * std::sqrt(m.gravity * r_min);
   // A gap this small is near (m): the bounds' windows would crawl (a die sliding along a wall, dice
   // resting side by side, a struck die moving off slowly), so the window is a guess, checked after.
   const double near = 0.1 * r_min;
   const double t_guess = 0.5 * step;  // the longest guessed window (s)
+  // Approaching: fast enough to sink a tenth of the touch tolerance within the longest window a
+  // touching pair takes (t_guess). Slower, a strike would only chase what is left of the last one
+  // (a die wedged between two bodies: strike after strike at one instant).
+  const double v_still = 0.1 * tol / t_guess;
   double touch_window = t_touching;
   // An overlap found after a window is lifted out; deeper than the floor's bound on a held corner's
   // sink in a step (held_corner_sink: 1e-4 r) it is counted as a correction (contact_overlaps).
