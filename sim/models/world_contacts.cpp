@@ -1,0 +1,152 @@
+#include "sim/models/world_contacts.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace dicesim::world_detail {
+
+PlacedHull placed(const World& w, int k, const RigidState& s) {
+  const DieModel& d = w.dice[static_cast<std::size_t>(k)];
+  return PlacedHull{d.vertices, d.face_normals, w.die_edges[static_cast<std::size_t>(k)], s.R, s.position};
+}
+
+PlacedHull placed(const ObstaclePiece& p) {
+  return PlacedHull{p.corners, p.face_normals, p.edge_dirs, Mat3::Identity(), Vec3::Zero()};
+}
+
+double axis_gap(std::span<const Vec3> a, double ra, std::span<const Vec3> b, double rb, const Vec3& n) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const Vec3& x : a) lo = std::min(lo, n.dot(x));
+  for (const Vec3& y : b) hi = std::max(hi, n.dot(y));
+  return lo - hi - ra - rb;
+}
+
+Touch touch_piece(const World& w, int k, const RigidState& s, const ObstaclePiece& p, SeparationCache* cache) {
+  const DieModel& d = w.dice[static_cast<std::size_t>(k)];
+  Touch t;
+  if (p.plane) {
+    double lo = std::numeric_limits<double>::infinity();
+    int low = 0;
+    for (int v = 0; v < d.vertex_count(); ++v) {
+      const double h = p.normal.dot(s.position + s.R * d.vertices[static_cast<std::size_t>(v)]);
+      if (h < lo) lo = h, low = v;
+    }
+    t.gap = lo - p.offset - d.rounding;
+    t.normal = p.normal;
+    t.point = s.position + s.R * d.vertices[static_cast<std::size_t>(low)] - d.rounding * p.normal;
+    return t;
+  }
+  const Separation sep = separation(placed(w, k, s), placed(p), cache);
+  t.gap = sep.distance - d.rounding;
+  t.normal = -sep.normal;
+  t.point = sep.point_a - d.rounding * t.normal;
+  t.degenerate = sep.degenerate;
+  return t;
+}
+
+Touch touch_die(const World& w, int i, const RigidState& si, int j, const RigidState& sj,
+                SeparationCache* cache) {
+  const DieModel& a = w.dice[static_cast<std::size_t>(i)];
+  const DieModel& b = w.dice[static_cast<std::size_t>(j)];
+  const Separation sep = separation(placed(w, i, si), placed(w, j, sj), cache);
+  Touch t;
+  t.gap = sep.distance - a.rounding - b.rounding;
+  t.normal = -sep.normal;
+  // Midway between the two rounded surfaces' witness points.
+  t.point = 0.5 * ((sep.point_a - a.rounding * t.normal) + (sep.point_b + b.rounding * t.normal));
+  t.degenerate = sep.degenerate;
+  return t;
+}
+
+Touch far_apart(double gap) {
+  Touch t;
+  t.gap = gap;
+  t.exact = false;
+  return t;
+}
+
+Mat3 to_normal_frame(const Vec3& n) { return Quat::FromTwoVectors(n, Vec3::UnitZ()).toRotationMatrix(); }
+
+ContactPatch piece_patch(const World& w, int i, const RigidState& s, const ObstaclePiece& p, const Touch& t,
+                         double tol) {
+  const DieModel& d = w.dice[static_cast<std::size_t>(i)];
+  const WorldCorners mine(d, s);
+  const double level_b = t.normal.dot(t.point) - t.gap;
+  ContactPatch patch = contact_patch({mine.corners(), d.rounding},
+                                     {p.plane ? std::span<const Vec3>{} : std::span<const Vec3>(p.corners), 0.0},
+                                     t.normal, level_b + t.gap, level_b, tol);
+  if (patch.n == 0) patch.points[static_cast<std::size_t>(patch.n++)] = t.point;
+  return patch;
+}
+
+ContactPatch dice_patch(const World& w, int i, const RigidState& si, int j, const RigidState& sj, const Touch& t,
+                        double tol) {
+  const DieModel& di = w.dice[static_cast<std::size_t>(i)];
+  const DieModel& dj = w.dice[static_cast<std::size_t>(j)];
+  const WorldCorners ci(di, si), cj(dj, sj);
+  const double mid = t.normal.dot(t.point);
+  ContactPatch patch = contact_patch({ci.corners(), di.rounding}, {cj.corners(), dj.rounding}, t.normal,
+                                     mid + 0.5 * t.gap, mid - 0.5 * t.gap, tol);
+  if (patch.n == 0) patch.points[static_cast<std::size_t>(patch.n++)] = t.point;
+  return patch;
+}
+
+double patch_approach(const ContactPatch& patch, const RigidState& si, const RigidState* sj, const Vec3& n,
+                      int* fastest) {
+  double un = std::numeric_limits<double>::infinity();
+  for (int q = 0; q < patch.n; ++q) {
+    const Vec3& x = patch.points[static_cast<std::size_t>(q)];
+    Vec3 rel = si.velocity + si.omega.cross(x - si.position);
+    if (sj) rel -= sj->velocity + sj->omega.cross(x - sj->position);
+    const double u = rel.dot(n);
+    if (u < un) {
+      un = u;
+      if (fastest) *fastest = q;
+    }
+  }
+  return un;
+}
+
+ImpactResult strike_fixed(const DieModel& d, RigidState& s, const Touch& t, const ContactPatch& patch,
+                          bool restitution, std::uint64_t& witness, PairMemo& memo) {
+  ContactSet c;
+  std::array<Vec3, kMaxContacts> r{};
+  const Mat3 Q = to_normal_frame(t.normal);
+  for (int q = 0; q < patch.n && c.n < kMaxContacts; ++q) {
+    c.vertex[c.n] = q;  // uniform materials: any corner's; the index matches the warm start's
+    r[static_cast<std::size_t>(c.n++)] = Q * (patch.points[static_cast<std::size_t>(q)] - s.position);
+  }
+  RigidState q{Q * s.position, Q * s.velocity, Q * s.R, Q * s.omega};
+  ContactImpulses warm, out;
+  warm.n = restitution ? 0 : memo.warm_n;  // (a stale start that would add energy is dropped by the law)
+  for (int k = 0; k < warm.n; ++k) {
+    warm.vertex[k] = k;
+    warm.P[k] = memo.warm[static_cast<std::size_t>(k)];
+  }
+  ImpactResult imp = apply_friction_impact_at(d, q, c, r.data(), restitution, &warm, &out);
+  memo.warm_n = std::min(out.n, static_cast<int>(memo.warm.size()));
+  for (int k = 0; k < memo.warm_n; ++k) memo.warm[static_cast<std::size_t>(k)] = out.P[k];
+  const Vec3 w_point = Q * (t.point - s.position);
+  if ((q.velocity + q.omega.cross(w_point)).z() < 0.0) {
+    ContactSet one;
+    one.n = 1;
+    one.vertex[0] = 0;
+    const ImpactResult more = apply_friction_impact_at(d, q, one, &w_point, restitution);
+    imp.corrections.add(more.corrections);
+    imp.normal_impulse += more.normal_impulse;
+    imp.energy_after = more.energy_after;
+    ++witness;
+  }
+  s.velocity = Q.transpose() * q.velocity;
+  s.omega = Q.transpose() * q.omega;
+  return imp;
+}
+
+Vec3 point_velocity(const RigidState& s, const Vec3& x) { return s.velocity + s.omega.cross(x - s.position); }
+
+Mat3 inverse_inertia(const DieModel& d, const Mat3& R) {
+  return R * d.principal_moments.cwiseInverse().asDiagonal() * R.transpose();
+}
+
+}  // namespace dicesim::world_detail
