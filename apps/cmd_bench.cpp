@@ -152,14 +152,17 @@ nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
           {"rise_dropped_per_toss", static_cast<double>(probe.rise_dropped) / np},
           // Several dice and obstacles (docs/world.md): windows of conservative advancement, those
           // taken again at half length (a near pair went too deep), contacts struck between
-          // bodies, dice struck at rest and moving again, slow strikes on a die at rest (held), strikes of an obstacle's nearest point
-          // after its corners', narrow-phase calls at their iteration cap, the deepest overlap.
+          // bodies, dice struck at rest and moving again, slow strikes on a die at rest (held),
+          // instants at the sweep cap, touches struck at the witness alone (an empty patch),
+          // strikes of the nearest point after the patch's, narrow-phase calls at their iteration
+          // cap, the deepest overlap.
           {"world_windows_per_toss", static_cast<double>(probe.windows) / np},
           {"world_windows_halved_per_toss", static_cast<double>(probe.windows_halved) / np},
           {"world_interactions_per_toss", static_cast<double>(probe.interactions) / np},
           {"world_woken_per_toss", static_cast<double>(probe.woken) / np},
           {"world_held_at_rest_per_toss", static_cast<double>(probe.held_at_rest) / np},
           {"world_sweeps_capped", probe.sweeps_capped},
+          {"world_patch_witness_only", probe.patch_witness_only},
           {"world_witness_strikes", probe.witness_strikes},
           {"world_narrow_degenerate", probe.narrow_degenerate},
           {"world_max_overlap_m", probe.max_overlap},

@@ -68,28 +68,34 @@ Touch far_apart(double gap) {
 
 Mat3 to_normal_frame(const Vec3& n) { return Quat::FromTwoVectors(n, Vec3::UnitZ()).toRotationMatrix(); }
 
-ContactPatch piece_patch(const World& w, int i, const RigidState& s, const ObstaclePiece& p, const Touch& t,
-                         double tol) {
-  const DieModel& d = w.dice[static_cast<std::size_t>(i)];
-  const WorldCorners mine(d, s);
-  const double level_b = t.normal.dot(t.point) - t.gap;
-  ContactPatch patch = contact_patch({mine.corners(), d.rounding},
-                                     {p.plane ? std::span<const Vec3>{} : std::span<const Vec3>(p.corners), 0.0},
-                                     t.normal, level_b + t.gap, level_b, tol);
-  if (patch.n == 0) patch.points[static_cast<std::size_t>(patch.n++)] = t.point;
+namespace {
+
+// An empty patch (the features' overlap lost to rounding) falls back to the witness point, counted.
+ContactPatch or_witness(ContactPatch patch, const Touch& t, std::uint64_t* witness_only) {
+  if (patch.n > 0) return patch;
+  patch.points[0] = t.point;
+  patch.n = 1;
+  if (witness_only) ++*witness_only;
   return patch;
 }
 
-ContactPatch dice_patch(const World& w, int i, const RigidState& si, int j, const RigidState& sj, const Touch& t,
-                        double tol) {
-  const DieModel& di = w.dice[static_cast<std::size_t>(i)];
-  const DieModel& dj = w.dice[static_cast<std::size_t>(j)];
-  const WorldCorners ci(di, si), cj(dj, sj);
+}  // namespace
+
+ContactPatch piece_patch(const DieModel& d, std::span<const Vec3> mine, const ObstaclePiece& p, const Touch& t,
+                         double tol, std::uint64_t* witness_only) {
+  const double level_b = t.normal.dot(t.point) - t.gap;
+  return or_witness(contact_patch({mine, d.rounding},
+                                  {p.plane ? std::span<const Vec3>{} : std::span<const Vec3>(p.corners), 0.0},
+                                  t.normal, level_b + t.gap, level_b, tol),
+                    t, witness_only);
+}
+
+ContactPatch dice_patch(const DieModel& di, std::span<const Vec3> ci, const DieModel& dj, std::span<const Vec3> cj,
+                        const Touch& t, double tol, std::uint64_t* witness_only) {
   const double mid = t.normal.dot(t.point);
-  ContactPatch patch = contact_patch({ci.corners(), di.rounding}, {cj.corners(), dj.rounding}, t.normal,
-                                     mid + 0.5 * t.gap, mid - 0.5 * t.gap, tol);
-  if (patch.n == 0) patch.points[static_cast<std::size_t>(patch.n++)] = t.point;
-  return patch;
+  return or_witness(contact_patch({ci, di.rounding}, {cj, dj.rounding}, t.normal, mid + 0.5 * t.gap,
+                                  mid - 0.5 * t.gap, tol),
+                    t, witness_only);
 }
 
 double patch_approach(const ContactPatch& patch, const RigidState& si, const RigidState* sj, const Vec3& n,
@@ -97,9 +103,7 @@ double patch_approach(const ContactPatch& patch, const RigidState& si, const Rig
   double un = std::numeric_limits<double>::infinity();
   for (int q = 0; q < patch.n; ++q) {
     const Vec3& x = patch.points[static_cast<std::size_t>(q)];
-    Vec3 rel = si.velocity + si.omega.cross(x - si.position);
-    if (sj) rel -= sj->velocity + sj->omega.cross(x - sj->position);
-    const double u = rel.dot(n);
+    const double u = (sj ? point_velocity(si, x) - point_velocity(*sj, x) : point_velocity(si, x)).dot(n);
     if (u < un) {
       un = u;
       if (fastest) *fastest = q;

@@ -64,6 +64,9 @@ class PairMemos {
   std::array<PairMemo, 1u << kBits> memos_{};
 };
 
+// The velocity of the rigid motion s at world point x.
+Vec3 point_velocity(const RigidState& s, const Vec3& x);
+
 // A lower bound on the gap between two bodies from any unit axis n (from b toward a): how far
 // a's corners lie beyond b's along it, less the roundings. At the last normal of a pair that has
 // moved a little, it is nearly the gap itself, for a few dot products instead of GJK.
@@ -97,14 +100,16 @@ class WorldCorners {
   std::span<const Vec3> corners_;
 };
 
-// Where die i touches a piece at `t` (contact_patch.hpp), within tol; the witness point if the
-// patch came out empty. The piece's surface plane at the touch is n . x = n . point - gap.
-ContactPatch piece_patch(const World& w, int i, const RigidState& s, const ObstaclePiece& p, const Touch& t,
-                         double tol);
+// Where die i (its corners `mine`, world) touches a piece at `t` (contact_patch.hpp), within tol;
+// the witness point if the patch came out empty (`*witness_only` counts it). The piece's surface
+// plane at the touch is n . x = n . point - gap.
+ContactPatch piece_patch(const DieModel& d, std::span<const Vec3> mine, const ObstaclePiece& p, const Touch& t,
+                         double tol, std::uint64_t* witness_only);
 
-// Where dice i and j touch at `t` (t.point lies midway between their surfaces).
-ContactPatch dice_patch(const World& w, int i, const RigidState& si, int j, const RigidState& sj, const Touch& t,
-                        double tol);
+// Where dice i and j (their corners, world) touch at `t` (t.point lies midway between their
+// surfaces); the witness point if the patch came out empty, counted.
+ContactPatch dice_patch(const DieModel& di, std::span<const Vec3> ci, const DieModel& dj, std::span<const Vec3> cj,
+                        const Touch& t, double tol, std::uint64_t* witness_only);
 
 // The least normal velocity of die i relative to the other body (its velocity and spin; zero for
 // a fixed one) over a patch's points: under -v_still, the pair approaches.
@@ -118,8 +123,7 @@ double patch_approach(const ContactPatch& patch, const RigidState& si, const Rig
 ImpactResult strike_fixed(const DieModel& d, RigidState& s, const Touch& t, const ContactPatch& patch,
                           bool restitution, std::uint64_t& witness, PairMemo& memo);
 
-Vec3 point_velocity(const RigidState& s, const Vec3& x);
-
+// A die's world inverse inertia at orientation R.
 Mat3 inverse_inertia(const DieModel& d, const Mat3& R);
 
 }  // namespace dicesim::world_detail

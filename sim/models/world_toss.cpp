@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <span>
 
 #include "sim/body/world.hpp"
@@ -218,6 +219,15 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         risky(i, j, p, t.gap);
       }
     };
+    // Each die's corners in the world, placed once an instant (when first needed: most pairs are
+    // settled by their bounds alone). A strike ends the instant's pass, so they stay valid.
+    std::array<std::optional<WorldCorners>, kMaxDice> placed_corners;
+    const auto corners_of = [&](int k) {
+      auto& c = placed_corners[static_cast<std::size_t>(k)];
+      if (!c) c.emplace(*runs[static_cast<std::size_t>(k)].m, runs[static_cast<std::size_t>(k)].s);
+      return c->corners();
+    };
+    std::uint64_t* witness_only = probe ? &probe->patch_witness_only : nullptr;
     for (int i = 0; i < n && !struck; ++i) {
       ImpulseRun& ri = runs[static_cast<std::size_t>(i)];
       const Reach& ai = reach[static_cast<std::size_t>(i)];
@@ -245,7 +255,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
             if (axis.squaredNorm() > 0.0) axis.normalize();
           }
           if (axis.squaredNorm() > 0.0)
-            bound = std::max(bound, axis_gap(WorldCorners(di, ri.s).corners(), di.rounding, piece.corners, 0.0, axis));
+            bound = std::max(bound, axis_gap(corners_of(i), di.rounding, piece.corners, 0.0, axis));
         }
         // The window the bounds allow at gap `gap` (tt: the touch, for its normal if exact).
         const auto safe_for = [&](const Touch& tt, double gap) {
@@ -269,7 +279,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         const auto approach = [&] { return closing_time(di, ri.s, t.normal, t.normal.dot(t.point) - t.gap, nullptr); };
         consider(t, safe, approach, [&] {
           // Every point of the patch (the witness alone may be any point of a face in contact).
-          const ContactPatch patch = piece_patch(w, i, ri.s, piece, t, tol);
+          const ContactPatch patch = piece_patch(di, corners_of(i), piece, t, tol, witness_only);
           const double un = patch_approach(patch, ri.s, nullptr, t.normal);
           if (!(un < -v_still)) {
             if (!(t.gap < -tol)) return false;
@@ -336,8 +346,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         PairMemo* memo = memos.die(i, j);
         double bound = far;
         if (bound <= near && memo->axis.squaredNorm() > 0.0)
-          bound = std::max(bound, axis_gap(WorldCorners(di, ri.s).corners(), di.rounding, WorldCorners(*rj.m, rj.s).corners(),
-                                           rj.m->rounding, memo->axis));
+          bound = std::max(bound, axis_gap(corners_of(i), di.rounding, corners_of(j), rj.m->rounding, memo->axis));
         const auto safe_for = [&](const Touch& tt, double gap) {
           double dt = std::max(gap / closing, sphere_dt);
           if (ai.flying && aj.flying) {  // both fly: gravity moves them alike, their relative velocity is constant
@@ -367,7 +376,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         };
         consider(t, safe, approach, [&] {
           // Every point of the patch (the witness alone may be any point of a face in contact).
-          const ContactPatch patch = dice_patch(w, i, ri.s, j, rj.s, t, tol);
+          const ContactPatch patch = dice_patch(di, corners_of(i), *rj.m, corners_of(j), t, tol, witness_only);
           int fastest = 0;
           const double un = patch_approach(patch, ri.s, &rj.s, t.normal, &fastest);
           // A die at rest is held by the floor: all the correction goes to the moving one.
