@@ -99,12 +99,13 @@ struct TossProbe {
   // contacts struck between two bodies (die and die, die and obstacle), dice struck at rest and
   // moving again, narrow-phase calls that ended at their iteration cap (their best estimate taken).
   std::uint64_t windows = 0;
-  std::uint64_t windows_halved = 0;  // ... taken again half as long (a nearly touching pair went too deep)
+  std::uint64_t windows_halved = 0;  // ... taken again shorter (a nearly touching pair went too deep)
   std::uint64_t interactions = 0;
   std::uint64_t woken = 0;
   std::uint64_t sweeps_capped = 0;  // instants whose strikes reached their cap, slow contacts left touching
-  std::uint64_t held_at_rest = 0;
-  std::uint64_t patch_witness_only = 0;  // touches whose contact patch came out empty: struck at the witness point alone  // slow die-on-die strikes against a die at rest, that die held where it lies
+  std::uint64_t held_at_rest = 0;  // slow die-on-die strikes against a die at rest, that die held where it lies
+  std::uint64_t patch_witness_only = 0;  // touches whose contact patch came out empty: struck at the witness point alone
+  std::uint64_t perched = 0;  // dice found resting off the floor on one fixed body (world_toss.cpp: perched)
   std::uint64_t narrow_degenerate = 0;
   std::uint64_t witness_strikes = 0;  // die-on-obstacle strikes whose nearest point, still approaching after its corners', was struck too
   double max_overlap = 0.0;  // the deepest overlap of two bodies found after a window (m), lifted out

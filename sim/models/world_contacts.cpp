@@ -147,6 +147,76 @@ ImpactResult strike_fixed(const DieModel& d, RigidState& s, const Touch& t, cons
   return imp;
 }
 
+bool held_still(const DieModel& d, const RigidState& s, std::span<const HeldTouch> touches, double tau) {
+  struct Point {
+    Vec3 r, n, t1, t2;
+    Mat3 W;  // the point's velocity change per unit impulse there
+    double inv_wnn = 0.0, mu = 0.0, pn = 0.0;
+    Eigen::Matrix2d inv_wtt;
+    Eigen::Vector2d pt = Eigen::Vector2d::Zero();
+  };
+  std::array<Point, (kMaxHolds + 1) * kMaxPatchPoints> pts;
+  std::size_t np = 0;
+  const Mat3 inv_i = inverse_inertia(d, s.R);
+  for (const HeldTouch& h : touches)
+    for (int q = 0; q < h.patch.n && np < pts.size(); ++q) {
+      Point& p = pts[np++];
+      p.r = h.patch.points[static_cast<std::size_t>(q)] - s.position;
+      p.n = h.normal;
+      p.t1 = h.normal.unitOrthogonal();
+      p.t2 = h.normal.cross(p.t1);
+      Mat3 X;
+      X << 0.0, -p.r.z(), p.r.y(), p.r.z(), 0.0, -p.r.x(), -p.r.y(), p.r.x(), 0.0;
+      p.W = Mat3::Identity() / d.mass - X * inv_i * X;
+      p.inv_wnn = 1.0 / p.n.dot(p.W * p.n);
+      Eigen::Matrix2d wtt;
+      wtt << p.t1.dot(p.W * p.t1), p.t1.dot(p.W * p.t2), p.t2.dot(p.W * p.t1), p.t2.dot(p.W * p.t2);
+      p.inv_wtt = wtt.inverse();
+      p.mu = h.mu;
+    }
+  if (np == 0) return false;
+  Vec3 v = -d.gravity * tau * Vec3::UnitZ(), w = Vec3::Zero();
+  const auto apply = [&](const Point& p, const Vec3& P) {
+    v += P / d.mass;
+    w += inv_i * p.r.cross(P);
+  };
+  const double still = 1e-6 * d.gravity * tau;
+  double last = std::numeric_limits<double>::infinity();  // the residual ten sweeps ago
+  for (int sweep = 0; sweep < kHeldSweeps; ++sweep) {
+    for (std::size_t k = 0; k < np; ++k) {
+      Point& p = pts[k];
+      Vec3 u = v + w.cross(p.r);
+      const double pn = std::max(0.0, p.pn - u.dot(p.n) * p.inv_wnn);
+      apply(p, (pn - p.pn) * p.n);
+      p.pn = pn;
+      u = v + w.cross(p.r);
+      Eigen::Vector2d pt = p.pt - p.inv_wtt * Eigen::Vector2d(u.dot(p.t1), u.dot(p.t2));
+      const double limit = p.mu * p.pn, norm = pt.norm();
+      if (norm > limit) pt *= limit / norm;
+      const Eigen::Vector2d dp = pt - p.pt;
+      apply(p, dp.x() * p.t1 + dp.y() * p.t2);
+      p.pt = pt;
+    }
+    const double residual = v.norm() + w.norm() * d.bounding_radius;
+    if (residual <= still) return true;
+    if (sweep % 10 == 9) {  // stalled: the least kinetic energy the cones allow is not zero
+      if (residual > 0.99 * last) return false;
+      last = residual;
+    }
+  }
+  return false;
+}
+
+HeldTouch floor_touch(const DieModel& d, const RigidState& s, double within) {
+  HeldTouch h;
+  h.mu = *std::min_element(d.vertex_friction.begin(), d.vertex_friction.end());
+  for (const Vec3& c : d.vertices) {
+    const Vec3 x = s.position + s.R * c - d.rounding * Vec3::UnitZ();
+    if (x.z() <= within && h.patch.n < kMaxPatchPoints) h.patch.points[static_cast<std::size_t>(h.patch.n++)] = x;
+  }
+  return h;
+}
+
 Vec3 point_velocity(const RigidState& s, const Vec3& x) { return s.velocity + s.omega.cross(x - s.position); }
 
 Mat3 inverse_inertia(const DieModel& d, const Mat3& R) {

@@ -31,12 +31,15 @@ PlacedHull placed(const World& w, int k, const RigidState& s);
 
 PlacedHull placed(const ObstaclePiece& p);
 
-// What a toss remembers of a pair between windows: the narrow phase's warm start, and the gap at
-// the last window's start (for the next guess's secant). Direct-mapped by the pair (die i and die
-// j, or die i and piece p, in that order): a slot is taken over by the last pair measured there.
+// What a toss remembers of a pair between windows: the narrow phase's warm start, and its gap at
+// the instants it was last measured at (for the next guess's secant). Direct-mapped by the pair
+// (die i and die j, or die i and piece p, in that order): a slot is taken over by the last pair
+// measured there.
 struct PairMemo {
   SeparationCache sep;
-  double gap = 0.0, at = -1.0;  // at < 0: none
+  double gap = 0.0, at = -1.0;            // at the latest instant measured (at < 0: none, or touching)
+  double prev_gap = 0.0, prev_at = -1.0;  // at the one before: an instant's later passes (after a
+                                          // strike elsewhere) measure the pair again at the same at
   Vec3 axis = Vec3::Zero();     // the last exact touch's normal (zero: none)
   // The impulses of the pair's last strike at its patch's points (in the touch's frame), to start
   // the next strike's Gauss-Seidel sweeps from: a die lying on another or on an obstacle's top is
@@ -63,6 +66,34 @@ class PairMemos {
   std::array<std::uint64_t, 1u << kBits> keys_{};  // 0: empty
   std::array<PairMemo, 1u << kBits> memos_{};
 };
+
+// The most fixed bodies (obstacles, dice at rest) one die's held_still weighs, besides the floor.
+inline constexpr int kMaxHolds = 4;
+
+// One fixed body's touch of a die (an obstacle, a die at rest, the floor), for held_still: the
+// points of its patch, its normal (into the die) and the friction coefficient there.
+struct HeldTouch {
+  ContactPatch patch;
+  Vec3 normal = Vec3::UnitZ();
+  double mu = 0.0;
+};
+
+// Whether forces at these touches, within their friction cones, can hold die d at s against
+// gravity: a static equilibrium. Tested as the plastic strike of a die given gravity's kick over
+// tau, from rest, at every point at once (projected Gauss-Seidel over the points, each in its own
+// normal's frame, up to kHeldSweeps sweeps): it minimises the kinetic energy over the impulses the
+// cones allow, so it stops the die when, and only when, such forces exist. Held: the die's points
+// end slower than 1e-6 g tau, an unbalanced acceleration under 1e-6 g (over the half second a
+// still die is otherwise watched, under 1.3 um of motion). Not held: the residual stalls (falls
+// less than 1 % in ten sweeps; where no such forces exist the sweeps converge to a die that still
+// moves), or is not met within kHeldSweeps (at worst a hold missed: the die is watched as before).
+// (Held dice converge geometrically: one wedged between a die and a pyramid's overhang, its residual
+// falling 0.7 in ten sweeps, took 370.)
+bool held_still(const DieModel& d, const RigidState& s, std::span<const HeldTouch> touches, double tau);
+inline constexpr int kHeldSweeps = 2000;
+
+// The die's corners within `within` of the floor, as a touch for held_still (n = 0: none).
+HeldTouch floor_touch(const DieModel& d, const RigidState& s, double within);
 
 // The velocity of the rigid motion s at world point x.
 Vec3 point_velocity(const RigidState& s, const Vec3& x);

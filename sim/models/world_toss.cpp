@@ -39,6 +39,8 @@ namespace {
 // kStillEnergy m g r, the toss is unresolved. A safety cap on contacts besides.
 constexpr double kStillTime = 0.5;      // s
 constexpr double kStillEnergy = 1e-4;   // of m g r
+// A die this still (kinetic energy, of m g r) that its contacts can hold is perched (run_world).
+constexpr double kPerchEnergy = 1e-4;
 constexpr int kMaxInteractions = 200000;
 // Strikes at one instant are Gauss-Seidel sweeps over the contacts there (see run_world): their cap.
 constexpr int kMaxSweeps = 16;
@@ -62,10 +64,10 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   }
   const double tol = 1e-6 * r_min;                       // a touch, as the floor's corner set
   const double v_slow = sustained_contact_speed(m, step);  // slower contacts are plastic (the stepper's threshold)
-  // The window while a pair touches without approaching: it starts at 0.05 contact steps, doubles
+  // The window while a pair touches without approaching: it starts at 0.05 contact steps, grows
   // after each such window taken whole (up to t_guess below), and is the length taken after one
-  // that had to be halved: a die lying on an obstacle's top or on another die waits in windows as
-  // long as its checks allow.
+  // that had to be taken again shorter: a die lying on an obstacle's top or on another die waits
+  // in windows as long as its checks allow.
   const double t_touching = 0.05 * step;
   // A gap this small is near (m): the bounds' windows would crawl (a die sliding along a wall, dice
   // resting side by side, a struck die moving off slowly), so the window is a guess, checked after.
@@ -76,6 +78,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   // (a die wedged between two bodies: strike after strike at one instant).
   const double v_still = 0.1 * tol / t_guess;
   double touch_window = t_touching;
+  double touch_growth = 2.0;
   // An overlap found after a window is lifted out; deeper than the floor's bound on a held corner's
   // sink in a step (held_corner_sink: 1e-4 r) it is counted as a correction (contact_overlaps).
   const double sink = 1e-4 * r_min;
@@ -102,36 +105,46 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     double gap;  // at the window's start
   };
   constexpr int kMaxRisky = 32;
-  constexpr int kMaxHalvings = 24;
+  constexpr int kMaxRetries = 24;
   std::array<RiskyPair, kMaxRisky> risky_pairs{};
   int risky_n = 0;
   std::vector<ImpulseRun> saved;
-  // Does a risky pair (all of them, if there were more than kMaxRisky) now overlap deeper than the sink?
-  const auto too_deep = [&] {
-    // Deeper than the sink, and deeper than at the window's start.
-    const auto deep_piece = [&](int i, std::size_t p, double start) {
-      const double gap = touch_piece(w, i, runs[static_cast<std::size_t>(i)].s, w.pieces[p], &memos.piece(i, p)->sep).gap;
-      return gap < -sink && gap < start;
+  // Does a risky pair (all of them, if there were more than kMaxRisky) now overlap deeper than the
+  // sink, and deeper than at the window's start? Then the fraction of the window to take again
+  // (1: none), from where each such pair would end in the middle of what a window may end it in:
+  //  - a pair that came from a gap, half the sink deep (touching within tol, up to the sink deep):
+  //    located as regula falsi from the window's start would, its gap taken as linear in time;
+  //  - a pair touching at the start (a die pressed into another body by gravity), half as deep as
+  //    the sink allows (no deeper than the sink, or than it started): its gap taken as falling with
+  //    the square of time (from rest against the other body).
+  // At most 0.9 of the window and at least 0.1.
+  const auto retry_fraction = [&] {
+    double fraction = 1.0;
+    const auto check = [&](double gap, double start) {
+      if (!(gap < -sink && gap < start)) return;
+      const double ratio = start > tol ? (start + 0.5 * sink) / (start - gap)
+                                       : std::sqrt(std::max(0.0, 0.5 * (start + sink) / (start - gap)));
+      fraction = std::min(fraction, std::clamp(ratio, 0.1, 0.9));
     };
-    const auto deep_pair = [&](int i, int j, double start) {
-      const double gap =
-          touch_die(w, i, runs[static_cast<std::size_t>(i)].s, j, runs[static_cast<std::size_t>(j)].s, &memos.die(i, j)->sep).gap;
-      return gap < -sink && gap < start;
+    const auto piece_gap = [&](int i, std::size_t p) {
+      return touch_piece(w, i, runs[static_cast<std::size_t>(i)].s, w.pieces[p], &memos.piece(i, p)->sep).gap;
+    };
+    const auto pair_gap = [&](int i, int j) {
+      return touch_die(w, i, runs[static_cast<std::size_t>(i)].s, j, runs[static_cast<std::size_t>(j)].s, &memos.die(i, j)->sep)
+          .gap;
     };
     if (risky_n > kMaxRisky) {
       for (int i = 0; i < n; ++i) {
-        for (std::size_t p = 0; p < w.pieces.size(); ++p)
-          if (deep_piece(i, p, 0.0)) return true;
-        for (int j = i + 1; j < n; ++j)
-          if (deep_pair(i, j, 0.0)) return true;
+        for (std::size_t p = 0; p < w.pieces.size(); ++p) check(piece_gap(i, p), 0.0);
+        for (int j = i + 1; j < n; ++j) check(pair_gap(i, j), 0.0);
       }
-      return false;
+      return fraction;
     }
     for (int k = 0; k < risky_n; ++k) {
       const RiskyPair& q = risky_pairs[static_cast<std::size_t>(k)];
-      if (q.j >= 0 ? deep_pair(q.i, q.j, q.gap) : deep_piece(q.i, static_cast<std::size_t>(q.p), q.gap)) return true;
+      check(q.j >= 0 ? pair_gap(q.i, q.j) : piece_gap(q.i, static_cast<std::size_t>(q.p)), q.gap);
     }
-    return false;
+    return fraction;
   };
 
   double T = 0.0;
@@ -144,6 +157,58 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   std::uint64_t witness_strikes = 0;
   std::array<double, kMaxDice> still_since;  // per die: since when it has been held still off its rest (-1: moving)
   still_since.fill(-1.0);
+  // Perched: a still die held where it is by the fixed bodies it touches (obstacles, dice at rest,
+  // the floor) with forces inside their friction cones (held_still: a static equilibrium), off its
+  // rest on a face: leaning on a wall or on a die, lying on an obstacle's top. It waits as a die at
+  // rest does (others strike it held where it lies; a fast strike wakes it, and so does any die at
+  // rest woken, which it may lean on), and shows no face: once every die rests, the toss is
+  // unresolved. (Unperched, each window would repeat its fall and its strikes until kStillTime
+  // ended the toss so, or, jittering, it might creep out of a hold that friction keeps in fact.)
+  std::array<bool, kMaxDice> perched{};
+  const auto at_rest = [&](int k) { return runs[static_cast<std::size_t>(k)].state == RunState::Settled || perched[static_cast<std::size_t>(k)]; };
+  // Per die, the fixed bodies it was struck against slowly at this instant (ok false: a fast
+  // strike, one with a moving die, or more than kMaxHolds bodies).
+  struct Holds {
+    bool ok = true;
+    int n = 0;
+    std::array<int, kMaxHolds> body{};  // the piece, or pieces.size() + the die at rest
+    std::array<HeldTouch, kMaxHolds + 1> touch{};  // and the floor's, last
+  };
+  std::array<Holds, kMaxDice> holds{};
+  const auto hold = [&](int k, int body, const Touch& t, const ContactPatch& patch, const DieModel& against) {
+    Holds& h = holds[static_cast<std::size_t>(k)];
+    if (!h.ok) return;
+    int q = 0;
+    while (q < h.n && h.body[static_cast<std::size_t>(q)] != body) ++q;
+    if (q == kMaxHolds) {
+      h.ok = false;
+      return;
+    }
+    if (q == h.n) ++h.n;
+    h.body[static_cast<std::size_t>(q)] = body;
+    h.touch[static_cast<std::size_t>(q)] = HeldTouch{
+        patch, t.normal, *std::min_element(against.vertex_friction.begin(), against.vertex_friction.end())};
+  };
+  const auto wake = [&](int k) {
+    ImpulseRun& r = runs[static_cast<std::size_t>(k)];
+    if (r.state == RunState::Settled) {  // struck at rest: it moves again from here
+      r.state = RunState::Running;
+      r.sustained = true;
+    } else if (perched[static_cast<std::size_t>(k)]) {
+      perched[static_cast<std::size_t>(k)] = false;
+    } else {
+      return;
+    }
+    r.t = T;
+    r.moved();
+    if (probe) ++probe->woken;
+    for (int o = 0; o < n; ++o)  // dice perched on it
+      if (perched[static_cast<std::size_t>(o)]) {
+        perched[static_cast<std::size_t>(o)] = false;
+        runs[static_cast<std::size_t>(o)].t = T;
+        runs[static_cast<std::size_t>(o)].moved();
+      }
+  };
   std::uint64_t windows = 0;
   bool unresolved = false;
   std::array<Reach, kMaxDice> reach{};
@@ -151,14 +216,14 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     bool any_running = false;
     for (int k = 0; k < n; ++k) {
       ImpulseRun& r = runs[static_cast<std::size_t>(k)];
-      reach[static_cast<std::size_t>(k)] = reach_of(r, probe);
+      reach[static_cast<std::size_t>(k)] = perched[static_cast<std::size_t>(k)] ? Reach{} : reach_of(r, probe);
       // A die that rests by the floor's rule may still rock on its face (its energy below every
       // way off it); it waits where it is, and still: the others strike a body that does not move.
       if (r.state == RunState::Settled) {
         r.s.velocity.setZero();
         r.s.omega.setZero();
       }
-      any_running = any_running || r.state == RunState::Running;
+      any_running = any_running || (r.state == RunState::Running && !perched[static_cast<std::size_t>(k)]);
     }
     if (!any_running) break;
     if (T >= m.max_time) {
@@ -182,6 +247,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     // thick: the thinner body's least width; closing: the pair's whole-toss speed bound.
     const auto consider = [&](const Touch& t, auto&& safe, auto&& approach, auto&& strike, int i, int j, int p,
                               double thick, double closing, PairMemo& memo) {
+      if (memo.at != T) memo.prev_gap = memo.gap, memo.prev_at = memo.at;
       if (t.gap > tol) {
         double dt = safe(t.gap);
         if (t.gap < near) {
@@ -196,9 +262,10 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
           // the other. Checked after the window (and located by halving if it went deeper than
           // the sink).
           double predicted = approach();
-          if (memo.at >= 0.0 && memo.at < T) {
-            const double last = T - memo.at;
-            predicted = std::max(predicted, memo.gap > t.gap ? t.gap * last / (memo.gap - t.gap) : 2.0 * last);
+          if (memo.prev_at >= 0.0) {
+            const double last = T - memo.prev_at;
+            predicted =
+                std::max(predicted, memo.prev_gap > t.gap ? t.gap * last / (memo.prev_gap - t.gap) : 2.0 * last);
           }
           const double guess = std::min({predicted, t_guess, (t.gap + 0.5 * thick) / closing});
           if (guess > dt) {
@@ -211,7 +278,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         memo.at = T;
         return;
       }
-      memo.at = -1.0;
+      memo.at = memo.prev_at = -1.0;
       if (strike()) {
         struck = true;
       } else {
@@ -279,7 +346,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         const auto approach = [&] { return closing_time(di, ri.s, t.normal, t.normal.dot(t.point) - t.gap, nullptr); };
         consider(t, safe, approach, [&] {
           // Every point of the patch (the witness alone may be any point of a face in contact).
-          const ContactPatch patch = piece_patch(di, corners_of(i), piece, t, tol, witness_only);
+          const ContactPatch patch = piece_patch(di, corners_of(i), piece, t, sink, witness_only);
           const double un = patch_approach(patch, ri.s, nullptr, t.normal);
           if (!(un < -v_still)) {
             if (!(t.gap < -tol)) return false;
@@ -294,6 +361,8 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
               w.die_against[static_cast<std::size_t>(i)][static_cast<std::size_t>(w.piece_material[p])];
           const ImpactResult imp = strike_fixed(against, ri.s, t, patch, bounce, witness_strikes, *memo);
           ri.corrections.add(imp.corrections);
+          if (bounce) holds[static_cast<std::size_t>(i)].ok = false;
+          else hold(i, static_cast<int>(p), t, patch, against);
           if (t.gap < -tol) {  // found overlapping: struck, and lifted out along the normal
             overlap_found(ri, t.gap);
             ri.s.position -= t.gap * t.normal;
@@ -376,11 +445,11 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         };
         consider(t, safe, approach, [&] {
           // Every point of the patch (the witness alone may be any point of a face in contact).
-          const ContactPatch patch = dice_patch(di, corners_of(i), *rj.m, corners_of(j), t, tol, witness_only);
+          const ContactPatch patch = dice_patch(di, corners_of(i), *rj.m, corners_of(j), t, sink, witness_only);
           int fastest = 0;
           const double un = patch_approach(patch, ri.s, &rj.s, t.normal, &fastest);
           // A die at rest is held by the floor: all the correction goes to the moving one.
-          const double share = rj.state == RunState::Settled ? 1.0 : rj.m->mass / (di.mass + rj.m->mass);
+          const double share = at_rest(j) ? 1.0 : rj.m->mass / (di.mass + rj.m->mass);
           if (!(un < -v_still)) {
             if (!(t.gap < -tol)) return false;
             overlap_found(ri, t.gap);  // overlapping though moving apart: moved apart, then looked at again
@@ -392,7 +461,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
           }
           const bool bounce = -un > v_slow;
           if (!bounce && sweeps_capped) return false;  // left touching: checked after the window
-          if (!bounce && rj.state == RunState::Settled) {
+          if (!bounce && at_rest(j)) {
             // A slow contact with a die at rest: the floor's friction holds that die. (The plastic
             // push of a contact under 4 g h could slide it, at most, v^2 / (2 mu g) on its face:
             // half a millimetre at mu = 0.4.) Die i is struck against it held where it lies, at
@@ -401,6 +470,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
                 w.die_pair_material[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)])];
             const ImpactResult imp = strike_fixed(against, ri.s, t, patch, /*restitution=*/false, witness_strikes, *memo);
             ri.corrections.add(imp.corrections);
+            hold(i, static_cast<int>(w.pieces.size()) + j, t, patch, against);
             if (t.gap < -tol) {
               overlap_found(ri, t.gap);
               ri.s.position -= t.gap * t.normal;
@@ -457,17 +527,13 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
             rj.s.position += (1.0 - share) * t.gap * t.normal;
           }
           if (bounce) ++ri.bounces, ++rj.bounces;
+          holds[static_cast<std::size_t>(i)].ok = holds[static_cast<std::size_t>(j)].ok = false;
           for (ImpulseRun* r : {&ri, &rj}) {
             r->after_impact = false;
             r->since_impact = 0.0;
             r->moved();
-            if (r->state == RunState::Settled) {  // struck at rest: it moves again from here
-              r->state = RunState::Running;
-              r->sustained = true;
-              r->t = T;
-              if (probe) ++probe->woken;
-            }
           }
+          wake(j);
           if (probe) ++probe->interactions;
           return true;
         }, i, j, -1, std::min(w.die_width[static_cast<std::size_t>(i)], w.die_width[static_cast<std::size_t>(j)]), closing,
@@ -487,12 +553,31 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
 
     sweeps = 0;
     sweeps_capped = false;
+    // Perched: still since an earlier instant, struck at this one against fixed bodies alone, and
+    // held there by them with the floor, if it touches the floor (held_still).
+    for (int k = 0; k < n; ++k) {
+      Holds& h = holds[static_cast<std::size_t>(k)];
+      ImpulseRun& r = runs[static_cast<std::size_t>(k)];
+      if (h.ok && h.n > 0 && r.state == RunState::Running && !perched[static_cast<std::size_t>(k)] &&
+          still_since[static_cast<std::size_t>(k)] >= 0.0 &&
+          kinetic_energy(*r.m, r.s) < kPerchEnergy * r.m->mass * r.m->gravity * r.m->bounding_radius) {
+        h.touch[static_cast<std::size_t>(h.n)] = floor_touch(*r.m, r.s, sink);
+        if (held_still(*r.m, r.s, std::span(h.touch.data(), static_cast<std::size_t>(h.n) + 1), t_guess)) {
+          perched[static_cast<std::size_t>(k)] = true;
+          still_since[static_cast<std::size_t>(k)] = -1.0;
+          r.s.velocity.setZero();
+          r.s.omega.setZero();
+          if (probe) ++probe->perched;
+        }
+      }
+      h = Holds{};
+    }
     // Held still: judged once this instant's strikes are done (before them, a die lying on an
     // obstacle carries what gravity gave it over the last window, which the strikes take away).
     for (int k = 0; k < n; ++k) {
       const ImpulseRun& r = runs[static_cast<std::size_t>(k)];
       double& since = still_since[static_cast<std::size_t>(k)];
-      const bool still = r.state == RunState::Running &&
+      const bool still = r.state == RunState::Running && !perched[static_cast<std::size_t>(k)] &&
                          kinetic_energy(*r.m, r.s) < kStillEnergy * r.m->mass * r.m->gravity * r.m->bounding_radius;
       if (!still) since = -1.0;
       else if (since < 0.0) since = T;
@@ -501,23 +586,29 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     if (unresolved) break;
 
     // Advance every running die to the window's end. A window longer than its bounds allow (a
-    // risky pair) is taken again half as long while such a pair ends deeper than the sink bound:
-    // the contact located, as the floor's stepper locates a new corner's.
+    // risky pair) is taken again shorter (retry_fraction) while such a pair ends deeper than the
+    // sink bound: the contact located, as the floor's stepper locates a new corner's.
     if (risky_n > 0) saved.assign(runs.begin(), runs.end());
     for (int tries = 0;; ++tries) {
       const double t_end = std::min(T + window, m.max_time);
       ++windows;
-      for (ImpulseRun& r : runs) {
-        if (r.state != RunState::Running) continue;
+      for (int k = 0; k < n; ++k) {
+        ImpulseRun& r = runs[static_cast<std::size_t>(k)];
+        if (r.state != RunState::Running || perched[static_cast<std::size_t>(k)]) continue;
         r.advance(t_end, probe);
       }
-      if (risky_n == 0 || tries == kMaxHalvings || !too_deep()) {
-        if (by_touch) touch_window = tries == 0 ? std::min(t_guess, 2.0 * touch_window) : window;
+      const double again = risky_n == 0 || tries == kMaxRetries ? 1.0 : retry_fraction();
+      if (again >= 1.0) {
+        // A touching pair's window doubles while whole windows pass; once one had to be taken
+        // again, it grows by a quarter (doubling, every other window would be taken again).
+        if (by_touch && tries == 0) touch_window = std::min(t_guess, touch_growth * touch_window);
+        else if (by_touch) touch_window = window, touch_growth = 1.25;
+        else touch_growth = 2.0;
         T = t_end;
         break;
       }
       std::copy(saved.begin(), saved.end(), runs.begin());
-      window *= 0.5;
+      window *= again;
       if (probe) ++probe->windows_halved;
     }
     for (const ImpulseRun& r : runs)
