@@ -114,23 +114,6 @@ Touch far_apart(double gap);
 // Frame turning n to +z (the floor law's normal), as a rotation matrix.
 Mat3 to_normal_frame(const Vec3& n);
 
-// A die's corners in the world (the centres of its rounded corners).
-class WorldCorners {
- public:
-  WorldCorners(const DieModel& d, const RigidState& s) {
-    const std::size_t n = d.vertices.size();
-    Vec3* out = n <= inline_.size() ? inline_.data() : (heap_.resize(n), heap_.data());
-    for (std::size_t v = 0; v < n; ++v) out[v] = s.position + s.R * d.vertices[v];
-    corners_ = std::span<const Vec3>(out, n);
-  }
-  std::span<const Vec3> corners() const { return corners_; }
-
- private:
-  std::array<Vec3, 32> inline_;
-  std::vector<Vec3> heap_;
-  std::span<const Vec3> corners_;
-};
-
 // Where die i (its corners `mine`, world) touches a piece at `t` (contact_patch.hpp), within tol;
 // the witness point if the patch came out empty (`*witness_only` counts it). The piece's surface
 // plane at the touch is n . x = n . point - gap.

@@ -19,8 +19,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <optional>
 #include <span>
+#include <vector>
 
 #include "sim/body/world.hpp"
 #include "sim/dynamics/contact.hpp"
@@ -219,6 +219,8 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   std::uint64_t windows = 0;
   bool unresolved = false;
   std::array<Reach, kMaxDice> reach{};
+  std::array<std::vector<Vec3>, kMaxDice> corner_buf;  // per die: its corners in the world (corners_of)
+  std::array<bool, kMaxDice> corners_placed{};
   while (!unresolved) {
     bool any_running = false;
     for (int k = 0; k < n; ++k) {
@@ -293,13 +295,19 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         risky(i, j, p, t.gap);
       }
     };
-    // Each die's corners in the world, placed once an instant (when first needed: most pairs are
-    // settled by their bounds alone). A strike ends the instant's pass, so they stay valid.
-    std::array<std::optional<WorldCorners>, kMaxDice> placed_corners;
+    // Each die's corners in the world, placed once a pass (when first needed: most pairs are
+    // settled by their bounds alone). A strike ends the pass, so they stay valid within it.
+    corners_placed.fill(false);
     const auto corners_of = [&](int k) {
-      auto& c = placed_corners[static_cast<std::size_t>(k)];
-      if (!c) c.emplace(*runs[static_cast<std::size_t>(k)].m, runs[static_cast<std::size_t>(k)].s);
-      return c->corners();
+      std::vector<Vec3>& c = corner_buf[static_cast<std::size_t>(k)];
+      if (!corners_placed[static_cast<std::size_t>(k)]) {
+        const DieModel& d = *runs[static_cast<std::size_t>(k)].m;
+        const RigidState& s = runs[static_cast<std::size_t>(k)].s;
+        c.resize(d.vertices.size());
+        for (std::size_t v = 0; v < c.size(); ++v) c[v] = s.position + s.R * d.vertices[v];
+        corners_placed[static_cast<std::size_t>(k)] = true;
+      }
+      return std::span<const Vec3>(c);
     };
     std::uint64_t* witness_only = probe ? &probe->patch_witness_only : nullptr;
     for (int i = 0; i < n && !struck; ++i) {
