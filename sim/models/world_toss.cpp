@@ -90,6 +90,8 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   };
 
   PairMemos memos;
+  std::array<std::vector<Vec3>, kMaxDice> corner_buf;  // per die: its corners in the world (corners_of)
+  std::array<bool, kMaxDice> corners_placed{};
 
   // The start must be possible: no die inside another or inside an obstacle. (Of the polyhedra,
   // only those whose box meets the die's bounding sphere can hold it: a craps backboard's 320
@@ -135,12 +137,37 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
                                        : std::sqrt(std::max(0.0, 0.5 * (start + sink) / (start - gap)));
       fraction = std::min(fraction, std::clamp(ratio, 0.1, 0.9));
     };
+    // A pair's gap along its last normal is a lower bound (axis_gap): no deeper than the sink there,
+    // the pair is not too deep, and GJK need not run. (Corners placed afresh: the dice have moved.)
+    std::array<bool, kMaxDice> placed{};
+    const auto corners = [&](int k) {
+      std::vector<Vec3>& c = corner_buf[static_cast<std::size_t>(k)];
+      if (!placed[static_cast<std::size_t>(k)]) {
+        const DieModel& d = *runs[static_cast<std::size_t>(k)].m;
+        const RigidState& s = runs[static_cast<std::size_t>(k)].s;
+        c.resize(d.vertices.size());
+        for (std::size_t v = 0; v < c.size(); ++v) c[v] = s.position + s.R * d.vertices[v];
+        placed[static_cast<std::size_t>(k)] = true;
+      }
+      return std::span<const Vec3>(c);
+    };
     const auto piece_gap = [&](int i, std::size_t p) {
-      return touch_piece(w, i, runs[static_cast<std::size_t>(i)].s, w.pieces[p], &memos.piece(i, p)->sep).gap;
+      PairMemo* memo = memos.piece(i, p);
+      const ObstaclePiece& piece = w.pieces[p];
+      if (!piece.plane && memo->axis.squaredNorm() > 0.0) {
+        const double lower = axis_gap(corners(i), runs[static_cast<std::size_t>(i)].m->rounding, piece.corners, 0.0, memo->axis);
+        if (lower >= -sink) return lower;
+      }
+      return touch_piece(w, i, runs[static_cast<std::size_t>(i)].s, piece, &memo->sep).gap;
     };
     const auto pair_gap = [&](int i, int j) {
-      return touch_die(w, i, runs[static_cast<std::size_t>(i)].s, j, runs[static_cast<std::size_t>(j)].s, &memos.die(i, j)->sep)
-          .gap;
+      PairMemo* memo = memos.die(i, j);
+      if (memo->axis.squaredNorm() > 0.0) {
+        const double lower = axis_gap(corners(i), runs[static_cast<std::size_t>(i)].m->rounding, corners(j),
+                                      runs[static_cast<std::size_t>(j)].m->rounding, memo->axis);
+        if (lower >= -sink) return lower;
+      }
+      return touch_die(w, i, runs[static_cast<std::size_t>(i)].s, j, runs[static_cast<std::size_t>(j)].s, &memo->sep).gap;
     };
     if (risky_n > kMaxRisky) {
       for (int i = 0; i < n; ++i) {
@@ -221,8 +248,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   std::uint64_t windows = 0;
   bool unresolved = false;
   std::array<Reach, kMaxDice> reach{};
-  std::array<std::vector<Vec3>, kMaxDice> corner_buf;  // per die: its corners in the world (corners_of)
-  std::array<bool, kMaxDice> corners_placed{};
+
   while (!unresolved) {
     bool any_running = false;
     for (int k = 0; k < n; ++k) {
@@ -587,7 +613,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
           if (probe) ++probe->perched;
         }
       }
-      h = Holds{};
+      h.ok = true, h.n = 0;  // (its touches are written before they are read)
     }
     // Held still: judged once this instant's strikes are done (before them, a die lying on an
     // obstacle carries what gravity gave it over the last window, which the strikes take away).
