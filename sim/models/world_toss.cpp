@@ -90,8 +90,22 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   };
 
   PairMemos memos;
-  std::array<std::vector<Vec3>, kMaxDice> corner_buf;  // per die: its corners in the world (corners_of)
+  // Each die's corners in the world, placed when first needed after the dice last moved (most
+  // pairs are settled by their bounds alone): corners_placed is cleared at each pass (a strike
+  // ends it) and before each check after a window.
+  std::array<std::vector<Vec3>, kMaxDice> corner_buf;
   std::array<bool, kMaxDice> corners_placed{};
+  const auto corners_of = [&](int k) {
+    std::vector<Vec3>& c = corner_buf[static_cast<std::size_t>(k)];
+    if (!corners_placed[static_cast<std::size_t>(k)]) {
+      const DieModel& d = *runs[static_cast<std::size_t>(k)].m;
+      const RigidState& s = runs[static_cast<std::size_t>(k)].s;
+      c.resize(d.vertices.size());
+      for (std::size_t v = 0; v < c.size(); ++v) c[v] = s.position + s.R * d.vertices[v];
+      corners_placed[static_cast<std::size_t>(k)] = true;
+    }
+    return std::span<const Vec3>(c);
+  };
 
   // The start must be possible: no die inside another or inside an obstacle. (Of the polyhedra,
   // only those whose box meets the die's bounding sphere can hold it: a craps backboard's 320
@@ -139,23 +153,13 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     };
     // A pair's gap along its last normal is a lower bound (axis_gap): no deeper than the sink there,
     // the pair is not too deep, and GJK need not run. (Corners placed afresh: the dice have moved.)
-    std::array<bool, kMaxDice> placed{};
-    const auto corners = [&](int k) {
-      std::vector<Vec3>& c = corner_buf[static_cast<std::size_t>(k)];
-      if (!placed[static_cast<std::size_t>(k)]) {
-        const DieModel& d = *runs[static_cast<std::size_t>(k)].m;
-        const RigidState& s = runs[static_cast<std::size_t>(k)].s;
-        c.resize(d.vertices.size());
-        for (std::size_t v = 0; v < c.size(); ++v) c[v] = s.position + s.R * d.vertices[v];
-        placed[static_cast<std::size_t>(k)] = true;
-      }
-      return std::span<const Vec3>(c);
-    };
+    corners_placed.fill(false);
     const auto piece_gap = [&](int i, std::size_t p) {
       PairMemo* memo = memos.piece(i, p);
       const ObstaclePiece& piece = w.pieces[p];
       if (!piece.plane && memo->axis.squaredNorm() > 0.0) {
-        const double lower = axis_gap(corners(i), runs[static_cast<std::size_t>(i)].m->rounding, piece.corners, 0.0, memo->axis);
+        const double lower =
+            axis_gap(corners_of(i), runs[static_cast<std::size_t>(i)].m->rounding, piece.corners, 0.0, memo->axis);
         if (lower >= -sink) return lower;
       }
       return touch_piece(w, i, runs[static_cast<std::size_t>(i)].s, piece, &memo->sep).gap;
@@ -163,7 +167,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     const auto pair_gap = [&](int i, int j) {
       PairMemo* memo = memos.die(i, j);
       if (memo->axis.squaredNorm() > 0.0) {
-        const double lower = axis_gap(corners(i), runs[static_cast<std::size_t>(i)].m->rounding, corners(j),
+        const double lower = axis_gap(corners_of(i), runs[static_cast<std::size_t>(i)].m->rounding, corners_of(j),
                                       runs[static_cast<std::size_t>(j)].m->rounding, memo->axis);
         if (lower >= -sink) return lower;
       }
@@ -323,20 +327,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         risky(i, j, p, t.gap);
       }
     };
-    // Each die's corners in the world, placed once a pass (when first needed: most pairs are
-    // settled by their bounds alone). A strike ends the pass, so they stay valid within it.
-    corners_placed.fill(false);
-    const auto corners_of = [&](int k) {
-      std::vector<Vec3>& c = corner_buf[static_cast<std::size_t>(k)];
-      if (!corners_placed[static_cast<std::size_t>(k)]) {
-        const DieModel& d = *runs[static_cast<std::size_t>(k)].m;
-        const RigidState& s = runs[static_cast<std::size_t>(k)].s;
-        c.resize(d.vertices.size());
-        for (std::size_t v = 0; v < c.size(); ++v) c[v] = s.position + s.R * d.vertices[v];
-        corners_placed[static_cast<std::size_t>(k)] = true;
-      }
-      return std::span<const Vec3>(c);
-    };
+    corners_placed.fill(false);  // (corners_of: placed once a pass)
     std::uint64_t* witness_only = probe ? &probe->patch_witness_only : nullptr;
     for (int i = 0; i < n && !struck; ++i) {
       ImpulseRun& ri = runs[static_cast<std::size_t>(i)];
