@@ -82,7 +82,8 @@ TEST(WorldPerched, OnAnInclineFrictionDecides) {
     t.normal = n;
     t.mu = mu;
     for (const double x : {-0.008, 0.008})
-      for (const double y : {-0.008, 0.008}) t.patch.points[static_cast<std::size_t>(t.patch.n++)] = s.R * Vec3(x, y, -0.008);
+      for (const double y : {-0.008, 0.008})
+        t.patch.points[static_cast<std::size_t>(t.patch.n++)] = s.R * Vec3(x, y, -0.008);
     return std::array<HeldTouch, 1>{t};
   };
   EXPECT_TRUE(held_still(d, s, on_incline(0.70), kTau));

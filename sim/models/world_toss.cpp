@@ -171,7 +171,8 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
                                       runs[static_cast<std::size_t>(j)].m->rounding, memo->axis);
         if (lower >= -sink) return lower;
       }
-      return touch_die(w, i, runs[static_cast<std::size_t>(i)].s, j, runs[static_cast<std::size_t>(j)].s, &memo->sep).gap;
+      const RigidState& sj = runs[static_cast<std::size_t>(j)].s;
+      return touch_die(w, i, runs[static_cast<std::size_t>(i)].s, j, sj, &memo->sep).gap;
     };
     if (risky_n > kMaxRisky) {
       for (int i = 0; i < n; ++i) {
@@ -205,7 +206,9 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   // unresolved. (Unperched, each window would repeat its fall and its strikes until kStillTime
   // ended the toss so, or, jittering, it might creep out of a hold that friction keeps in fact.)
   std::array<bool, kMaxDice> perched{};
-  const auto at_rest = [&](int k) { return runs[static_cast<std::size_t>(k)].state == RunState::Settled || perched[static_cast<std::size_t>(k)]; };
+  const auto at_rest = [&](int k) {
+    return runs[static_cast<std::size_t>(k)].state == RunState::Settled || perched[static_cast<std::size_t>(k)];
+  };
   // Per die, the fixed bodies it was struck against slowly at this instant (ok false: a fast
   // strike, one with a moving die, or more than kMaxHolds bodies).
   struct Holds {
