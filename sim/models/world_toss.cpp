@@ -5,13 +5,14 @@
 //   |v_point| <= sqrt(2 E / m) + r sqrt(2 E / I_min),  E = kinetic + m g (z - z_rest),
 // a bound that holds for the rest of the toss (no impact and no step gains energy), and its
 // bounding sphere's gap closes no faster than its COM moves, so no pair passes through each other
-// at any spin. A near pair's window is a guess, checked after it and halved while the pair went
-// too deep. A pair whose gap falls within the touch tolerance is struck at that instant over its
-// contact patch (contact_patch.hpp): a die against an obstacle, or slowly against a die at rest,
-// by the floor's own law turned to the touch's normal; two moving dice by the law of two bodies
-// (pair_impact.hpp). Slow contacts (under the stepper's impact threshold, 4 g contact_step) are
+// at any spin. A near pair's window is a guess, checked after it and taken again shorter while the
+// pair went too deep. A pair whose gap falls within the touch tolerance is struck at that instant
+// over its contact patch (contact_patch.hpp): a die against an obstacle, or slowly against a die
+// at rest, by the floor's own law turned to the touch's normal; two moving dice by the law of two
+// bodies (pair_impact.hpp). Slow contacts (under the stepper's impact threshold, 4 g contact_step) are
 // plastic, as the floor's sustained contact is. A die that rests stays where it is as an obstacle
-// until another strikes it fast. The toss ends when every die rests. docs/world.md says more.
+// until another strikes it fast, and so does a die perched (held still off its rest by the bodies
+// it touches). The toss ends when every die rests. docs/world.md says more.
 #include "sim/models/world_toss.hpp"
 
 #include <algorithm>
@@ -303,7 +304,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
           // a gap that did not fall over the last window allows twice that window (a corner
           // turning toward the other's plane beside it need not meet it);
           // at most t_guess, and never so long that the bound could carry one body through half
-          // the other. Checked after the window (and located by halving if it went deeper than
+          // the other. Checked after the window (and located by retry_fraction if it went deeper than
           // the sink).
           double predicted = approach();
           if (memo.prev_at >= 0.0) {
