@@ -162,6 +162,7 @@ nlohmann::json bench_one(const BenchArgs& a, const std::string& fidelity) {
           {"world_woken_per_toss", static_cast<double>(probe.woken) / np},
           {"world_held_at_rest_per_toss", static_cast<double>(probe.held_at_rest) / np},
           {"world_perched_per_toss", static_cast<double>(probe.perched) / np},
+          {"world_retries_capped", probe.retries_capped},
           {"world_sweeps_capped", probe.sweeps_capped},
           {"world_patch_witness_only", probe.patch_witness_only},
           {"world_witness_strikes", probe.witness_strikes},

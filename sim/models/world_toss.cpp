@@ -37,11 +37,10 @@ namespace {
 
 // A die held still off its rest (leaning on a wall or another die, cocked; lying on an obstacle's
 // top) never rests on a face by the floor's rule: held this long, kinetic energy below
-// kStillEnergy m g r, the toss is unresolved. A safety cap on contacts besides.
+// kStillEnergy m g r, the toss is unresolved (unless perched first: run_world). A safety cap on
+// contacts besides.
 constexpr double kStillTime = 0.5;      // s
 constexpr double kStillEnergy = 1e-4;   // of m g r
-// A die this still (kinetic energy, of m g r) that its contacts can hold is perched (run_world).
-constexpr double kPerchEnergy = 1e-4;
 constexpr int kMaxInteractions = 200000;
 // Strikes at one instant are Gauss-Seidel sweeps over the contacts there (see run_world): their cap.
 constexpr int kMaxSweeps = 16;
@@ -54,7 +53,11 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   const World& w = *m.world;
   const int n = w.size();
   TossResult res;
-  std::vector<ImpulseRun> runs;
+  // The runs, their copies at a risky window's start, and the dice's corners: buffers kept by the
+  // thread from toss to toss (no allocation per toss; every toss fills what it reads).
+  thread_local std::vector<ImpulseRun> runs, saved;
+  thread_local std::array<std::vector<Vec3>, kMaxDice> corner_buf;
+  runs.clear();
   runs.reserve(static_cast<std::size_t>(n));
   double r_min = std::numeric_limits<double>::infinity(), step = 0.0;
   for (int k = 0; k < n; ++k) {
@@ -91,10 +94,12 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   };
 
   PairMemos memos;
+  const auto still = [](const ImpulseRun& r) {
+    return kinetic_energy(*r.m, r.s) < kStillEnergy * r.m->mass * r.m->gravity * r.m->bounding_radius;
+  };
   // Each die's corners in the world, placed when first needed after the dice last moved (most
   // pairs are settled by their bounds alone): corners_placed is cleared at each pass (a strike
   // ends it) and before each check after a window.
-  std::array<std::vector<Vec3>, kMaxDice> corner_buf;
   std::array<bool, kMaxDice> corners_placed{};
   const auto corners_of = [&](int k) {
     std::vector<Vec3>& c = corner_buf[static_cast<std::size_t>(k)];
@@ -134,7 +139,6 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   constexpr int kMaxRetries = 24;
   std::array<RiskyPair, kMaxRisky> risky_pairs{};
   int risky_n = 0;
-  std::vector<ImpulseRun> saved;
   // Does a risky pair (all of them, if there were more than kMaxRisky) now overlap deeper than the
   // sink, and deeper than at the window's start? Then the fraction of the window to take again
   // (1: none), from where each such pair would end in the middle of what a window may end it in:
@@ -597,8 +601,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
       Holds& h = holds[static_cast<std::size_t>(k)];
       ImpulseRun& r = runs[static_cast<std::size_t>(k)];
       if (h.ok && h.n > 0 && r.state == RunState::Running && !perched[static_cast<std::size_t>(k)] &&
-          still_since[static_cast<std::size_t>(k)] >= 0.0 &&
-          kinetic_energy(*r.m, r.s) < kPerchEnergy * r.m->mass * r.m->gravity * r.m->bounding_radius) {
+          still_since[static_cast<std::size_t>(k)] >= 0.0 && still(r)) {
         h.touch[static_cast<std::size_t>(h.n)] = floor_touch(*r.m, r.s, sink);
         if (held_still(*r.m, r.s, std::span(h.touch.data(), static_cast<std::size_t>(h.n) + 1), t_guess)) {
           perched[static_cast<std::size_t>(k)] = true;
@@ -615,9 +618,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     for (int k = 0; k < n; ++k) {
       const ImpulseRun& r = runs[static_cast<std::size_t>(k)];
       double& since = still_since[static_cast<std::size_t>(k)];
-      const bool still = r.state == RunState::Running && !perched[static_cast<std::size_t>(k)] &&
-                         kinetic_energy(*r.m, r.s) < kStillEnergy * r.m->mass * r.m->gravity * r.m->bounding_radius;
-      if (!still) since = -1.0;
+      if (!(r.state == RunState::Running && !perched[static_cast<std::size_t>(k)] && still(r))) since = -1.0;
       else if (since < 0.0) since = T;
       else if (T - since > kStillTime) unresolved = true;
     }
@@ -635,7 +636,11 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         if (r.state != RunState::Running || perched[static_cast<std::size_t>(k)]) continue;
         r.advance(t_end, probe);
       }
-      const double again = risky_n == 0 || tries == kMaxRetries ? 1.0 : retry_fraction();
+      double again = risky_n == 0 ? 1.0 : retry_fraction();
+      if (again < 1.0 && tries == kMaxRetries) {  // taken as it is: its overlap is lifted out next, counted if deep
+        again = 1.0;
+        if (probe) ++probe->retries_capped;
+      }
       if (again >= 1.0) {
         // A touching pair's window doubles while whole windows pass; once one had to be taken
         // again, it grows by a quarter (doubling, every other window would be taken again).
