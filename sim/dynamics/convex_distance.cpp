@@ -285,9 +285,9 @@ Separation separation(const PlacedHull& a, const PlacedHull& b, SeparationCache*
       c.v = s[0].w;
       c.v2 = c.v.squaredNorm();
     } else {
-      c = n == 2 ? closest_segment(s, 0, 1) : closest_triangle(s, 0, 1, 2);
+      c = n == 2 ? closest_segment(s, 0, 1) : n == 3 ? closest_triangle(s, 0, 1, 2) : closest_tetrahedron(s);
     }
-    n = keep_support(s, lambda, c, n);
+    if (!c.inside) n = keep_support(s, lambda, c, n);
     v = c.v;
     v2 = c.v2;
   } else {
@@ -315,6 +315,7 @@ Separation separation(const PlacedHull& a, const PlacedHull& b, SeparationCache*
     const Closest c = n == 1 ? closest_segment(s, 0, 1) : n == 2 ? closest_triangle(s, 0, 1, 2) : closest_tetrahedron(s);
     if (c.inside) {
       overlap = true;
+      ++n;  // (the tetrahedron, kept for the cache)
       break;
     }
     if (!(c.v2 < v2)) {
@@ -333,7 +334,7 @@ Separation separation(const PlacedHull& a, const PlacedHull& b, SeparationCache*
   if (!overlap && !converged) out.degenerate = true;  // the cap
 
   if (cache) {
-    cache->n = overlap ? 0 : n;
+    cache->n = n;
     for (int q = 0; q < cache->n; ++q) {
       cache->ia[q] = s[q].ia;
       cache->ib[q] = s[q].ib;

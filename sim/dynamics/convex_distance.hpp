@@ -46,11 +46,14 @@ struct Separation {
 // (a warm start: a pair that moved a little since converges in an iteration or two instead of
 // five or six). n = 0: none (a cold start from the support toward B).
 struct SeparationCache {
-  std::array<int, 3> ia{}, ib{};
+  std::array<int, 4> ia{}, ib{};
   int n = 0;
 };
 
-// `cache` (optional) is read to start from and written with the final simplex (n = 0 if overlapping).
+// `cache` (optional) is read to start from and written with the final simplex: up to 3 corners if
+// separated; if overlapping, the simplex that held the origin (4 corners, or fewer if it touched),
+// from which a pair still overlapping, as a touching pair measured again mostly is, is known to at
+// once.
 Separation separation(const PlacedHull& a, const PlacedHull& b, SeparationCache* cache = nullptr);
 
 // Distance from a world point to a placed hull (>0 outside, <=0 inside: minus the depth to the
