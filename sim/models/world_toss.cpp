@@ -112,6 +112,35 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     }
     return std::span<const Vec3>(c);
   };
+  // Each die's place, stamped: a new stamp whenever it may have moved (a window, a strike's lift,
+  // a window taken again). A pair's exact touch is kept with the stamps it was measured at and
+  // reused while they hold: a risky pair measured after its window is met again at the next
+  // pass, and a strike elsewhere leaves the other dice's pairs as they were.
+  std::array<std::uint64_t, kMaxDice> placed_at{};
+  std::uint64_t stamp = 0;
+  const auto moved = [&](int k) {
+    runs[static_cast<std::size_t>(k)].moved();
+    placed_at[static_cast<std::size_t>(k)] = ++stamp;
+  };
+  const auto piece_touch = [&](int i, std::size_t p, PairMemo& memo) -> const Touch& {
+    const std::uint64_t at = placed_at[static_cast<std::size_t>(i)];
+    if (!(memo.measured && memo.measured_i == at)) {
+      memo.touch = touch_piece(w, i, runs[static_cast<std::size_t>(i)].s, w.pieces[p], &memo.sep);
+      memo.measured = true;
+      memo.measured_i = at;
+    }
+    return memo.touch;
+  };
+  const auto die_touch = [&](int i, int j, PairMemo& memo) -> const Touch& {
+    const std::uint64_t at_i = placed_at[static_cast<std::size_t>(i)], at_j = placed_at[static_cast<std::size_t>(j)];
+    if (!(memo.measured && memo.measured_i == at_i && memo.measured_j == at_j)) {
+      memo.touch = touch_die(w, i, runs[static_cast<std::size_t>(i)].s, j, runs[static_cast<std::size_t>(j)].s, &memo.sep);
+      memo.measured = true;
+      memo.measured_i = at_i;
+      memo.measured_j = at_j;
+    }
+    return memo.touch;
+  };
 
   // The start must be possible: no die inside another or inside an obstacle. (Of the polyhedra,
   // only those whose box meets the die's bounding sphere can hold it: a craps backboard's 320
@@ -167,7 +196,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
             axis_gap(corners_of(i), runs[static_cast<std::size_t>(i)].m->rounding, piece.corners, 0.0, memo->axis);
         if (lower >= -sink) return lower;
       }
-      return touch_piece(w, i, runs[static_cast<std::size_t>(i)].s, piece, &memo->sep).gap;
+      return piece_touch(i, p, *memo).gap;
     };
     const auto pair_gap = [&](int i, int j) {
       PairMemo* memo = memos.die(i, j);
@@ -176,8 +205,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
                                       runs[static_cast<std::size_t>(j)].m->rounding, memo->axis);
         if (lower >= -sink) return lower;
       }
-      const RigidState& sj = runs[static_cast<std::size_t>(j)].s;
-      return touch_die(w, i, runs[static_cast<std::size_t>(i)].s, j, sj, &memo->sep).gap;
+      return die_touch(i, j, *memo).gap;
     };
     if (risky_n > kMaxRisky) {
       for (int i = 0; i < n; ++i) {
@@ -260,6 +288,10 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   std::uint64_t windows = 0;
   bool unresolved = false;
   std::array<Reach, kMaxDice> reach{};
+  // Each pass visits the dice from the one that set the last window: the window it sets again
+  // early, each other die's broad phase is pruned by it (a die flying toward a craps backboard
+  // while the other bounces off its pyramids in short windows).
+  int first = 0;
 
   while (!unresolved) {
     bool any_running = false;
@@ -284,6 +316,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     double window = m.max_time - T;
     bool by_touch = false;  // the window is touch_window (a touching pair's)
     bool struck = false;
+    int limiting = first;   // the die whose pair set the window, or was struck
     // safe(gap): the longest window the pair's bounds allow for that gap; approach(): how soon the
     // pair's corners, at their speeds now, would close it; strike(): strikes the pair if it
     // approaches (true).
@@ -322,7 +355,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
             risky(i, j, p, t.gap);
           }
         }
-        if (dt < window) window = dt, by_touch = false;
+        if (dt < window) window = dt, by_touch = false, limiting = i;
         memo.gap = t.gap;
         memo.at = T;
         return;
@@ -330,14 +363,19 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
       memo.at = memo.prev_at = -1.0;
       if (strike()) {
         struck = true;
+        limiting = i;
       } else {
-        if (touch_window < window) window = touch_window, by_touch = true;
+        if (touch_window < window) window = touch_window, by_touch = true, limiting = i;
         risky(i, j, p, t.gap);
       }
     };
     corners_placed.fill(false);  // (corners_of: placed once a pass)
     std::uint64_t* witness_only = probe ? &probe->patch_witness_only : nullptr;
-    for (int i = 0; i < n && !struck; ++i) {
+    // Two stages: the half-spaces and the other dice first, then the polyhedra through the tree,
+    // whose visits a shorter window prunes.
+    for (int stage = 0; stage < 2 && !struck; ++stage)
+    for (int q = 0; q < n && !struck; ++q) {
+      const int i = (first + q) % n;
       ImpulseRun& ri = runs[static_cast<std::size_t>(i)];
       const Reach& ai = reach[static_cast<std::size_t>(i)];
       const double vi = ai.any;
@@ -353,9 +391,12 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
             sphere_gap > 0.0 ? sphere_fixed_window(ai, sphere_gap, piece.plane ? piece.normal : Vec3::Zero(), m.gravity)
                              : 0.0;
         if (sphere_dt >= window) return;
-        PairMemo* memo = memos.piece(i, p);
+        // (The pair's memo taken only once it is needed: a far pair settled by its bound leaves the
+        // memos to the pairs that use them.)
+        PairMemo* memo = nullptr;
         double bound = lower;
         if (bound <= near && !piece.plane) {
+          memo = memos.piece(i, p);
           // Along the pair's last normal, or (none yet) from the piece's box toward the die's centre.
           Vec3 axis = memo->axis;
           if (axis.squaredNorm() == 0.0) {
@@ -370,8 +411,10 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         const auto safe_for = [&](const Touch& tt, double gap) {
           double dt = std::max(gap / vi, sphere_dt);
           if (ai.flying) {  // gravity's part of the approach, along the piece's normal only (if known)
+            // (Along a known normal the COM may be moving away faster than the spin can bring a
+            // point back: the gap then grows until gravity turns it.)
             const double g_in = tt.exact ? m.gravity * tt.normal.z() : m.gravity;
-            const double v_in = tt.exact ? std::max(0.0, -ai.v.dot(tt.normal)) : ai.v.norm();
+            const double v_in = tt.exact ? -ai.v.dot(tt.normal) : ai.v.norm();
             const double flown = window_for(gap, v_in + ai.spin, std::max(0.0, g_in));
             dt = std::max(dt, std::min(flown, ai.free_for));
           }
@@ -380,12 +423,15 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         // Even at its lower bound, a pair that allows the window as it stands is not measured
         // (a guess only lengthens a pair's window).
         if (bound > tol && safe_for(far_apart(bound), bound) >= window) return;
-        const Touch t = bound > near ? far_apart(bound) : touch_piece(w, i, ri.s, piece, &memo->sep);
+        if (!memo) memo = memos.piece(i, p);
+        const Touch t = bound > near ? far_apart(bound) : piece_touch(i, p, *memo);
         if (t.exact) memo->axis = t.normal;
         if (t.degenerate && probe) ++probe->narrow_degenerate;
         const auto safe = [&](double gap) { return safe_for(t, gap); };
         // The other surface's plane at the touch: n . x = n . point - gap.
-        const auto approach = [&] { return closing_time(di, ri.s, t.normal, t.normal.dot(t.point) - t.gap, nullptr); };
+        const auto approach = [&] {
+          return closing_time(di, corners_of(i), ri.s, t.normal, t.normal.dot(t.point) - t.gap, nullptr);
+        };
         consider(t, safe, approach, [&] {
           // Every point of the patch (the witness alone may be any point of a face in contact).
           const ContactPatch patch = piece_patch(di, corners_of(i), piece, t, sink, witness_only);
@@ -394,7 +440,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
             if (!(t.gap < -tol)) return false;
             overlap_found(ri, t.gap);  // overlapping though moving apart: lifted out, then looked at again
             ri.s.position -= t.gap * t.normal;
-            ri.moved();
+            moved(i);
             return true;
           }
           const bool bounce = -un > v_slow;
@@ -412,16 +458,17 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
           if (bounce) ++ri.bounces;
           ri.after_impact = false;
           ri.since_impact = 0.0;
-          ri.moved();
+          moved(i);
           if (probe) ++probe->interactions;
           return true;
         }, i, -1, static_cast<int>(p), std::min(w.die_width[static_cast<std::size_t>(i)], w.piece_width[p]), vi, *memo);
       };
       // Half-spaces each; the polyhedra through the tree, those whose box the bound reaches.
-      for (const int p : w.plane_pieces) {
-        if (struck) break;
-        piece_pair(static_cast<std::size_t>(p), 0.0);
-      }
+      if (stage == 0)
+        for (const int p : w.plane_pieces) {
+          if (struck) break;
+          piece_pair(static_cast<std::size_t>(p), 0.0);
+        }
       // How far a piece's box may be and still be reached within the window: by any point at the
       // whole-toss bound, or by the bounding sphere (sphere_fixed_window, any direction).
       const auto reach_now = [&] {
@@ -433,12 +480,12 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         }
         return std::max(tol, far);
       };
-      if (!struck)
+      if (stage == 1 && !struck)
         w.piece_tree.visit_near(ri.s.position, di.bounding_radius, reach_now(), [&](int p, double lower) {
           piece_pair(static_cast<std::size_t>(p), lower);
           return reach_now();
         });
-      for (int j = 0; j < n && !struck; ++j) {
+      for (int j = 0; j < n && stage == 0 && !struck; ++j) {
         if (j == i) continue;
         ImpulseRun& rj = runs[static_cast<std::size_t>(j)];
         const Reach& aj = reach[static_cast<std::size_t>(j)];
@@ -454,18 +501,21 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
                                 : spheres_window(ai, aj, rj.s.position - ri.s.position,
                                                  di.bounding_radius + rj.m->bounding_radius);
         if (sphere_dt >= window) continue;
-        PairMemo* memo = memos.die(i, j);
+        PairMemo* memo = nullptr;  // (as for a piece)
         double bound = far;
-        if (bound <= near && memo->axis.squaredNorm() > 0.0)
-          bound = std::max(bound, axis_gap(corners_of(i), di.rounding, corners_of(j), rj.m->rounding, memo->axis));
+        if (bound <= near) {
+          memo = memos.die(i, j);
+          if (memo->axis.squaredNorm() > 0.0)
+            bound = std::max(bound, axis_gap(corners_of(i), di.rounding, corners_of(j), rj.m->rounding, memo->axis));
+        }
         const auto safe_for = [&](const Touch& tt, double gap) {
           double dt = std::max(gap / closing, sphere_dt);
           if (ai.flying && aj.flying) {  // both fly: gravity moves them alike, their relative velocity is constant
-            const double v_in = tt.exact ? std::max(0.0, -(ai.v - aj.v).dot(tt.normal)) : (ai.v - aj.v).norm();
+            const double v_in = tt.exact ? -(ai.v - aj.v).dot(tt.normal) : (ai.v - aj.v).norm();
             const double flown = window_for(gap, v_in + ai.spin + aj.spin, 0.0);
             dt = std::max(dt, std::min(flown, std::min(ai.free_for, aj.free_for)));
           } else if (ai.flying && vj == 0.0) {  // one flies at one at rest: as at an obstacle
-            const double v_in = tt.exact ? std::max(0.0, -ai.v.dot(tt.normal)) : ai.v.norm();
+            const double v_in = tt.exact ? -ai.v.dot(tt.normal) : ai.v.norm();
             const double flown =
                 window_for(gap, v_in + ai.spin, std::max(0.0, tt.exact ? m.gravity * tt.normal.z() : m.gravity));
             dt = std::max(dt, std::min(flown, ai.free_for));
@@ -473,7 +523,8 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
           return dt;
         };
         if (bound > tol && safe_for(far_apart(bound), bound) >= window) continue;  // as for a piece
-        const Touch t = bound > near ? far_apart(bound) : touch_die(w, i, ri.s, j, rj.s, &memo->sep);
+        if (!memo) memo = memos.die(i, j);
+        const Touch t = bound > near ? far_apart(bound) : die_touch(i, j, *memo);
         if (t.exact) memo->axis = t.normal;
         if (t.degenerate && probe) ++probe->narrow_degenerate;
         const auto safe = [&](double gap) { return safe_for(t, gap); };
@@ -482,8 +533,8 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
           // there. (t.point is midway between the two surfaces.)
           const double level_j = t.normal.dot(t.point) - 0.5 * t.gap;     // j's surface, seen from i
           const double level_i = -(t.normal.dot(t.point) + 0.5 * t.gap);  // i's surface, seen from j (normal -n)
-          return std::min(closing_time(di, ri.s, t.normal, level_j, &rj.s),
-                          closing_time(*rj.m, rj.s, -t.normal, level_i, &ri.s));
+          return std::min(closing_time(di, corners_of(i), ri.s, t.normal, level_j, &rj.s),
+                          closing_time(*rj.m, corners_of(j), rj.s, -t.normal, level_i, &ri.s));
         };
         consider(t, safe, approach, [&] {
           // Every point of the patch (the witness alone may be any point of a face in contact).
@@ -497,8 +548,8 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
             overlap_found(ri, t.gap);  // overlapping though moving apart: moved apart, then looked at again
             ri.s.position -= share * t.gap * t.normal;
             rj.s.position += (1.0 - share) * t.gap * t.normal;
-            ri.moved();
-            rj.moved();
+            moved(i);
+            moved(j);
             return true;
           }
           const bool bounce = -un > v_slow;
@@ -519,7 +570,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
             }
             ri.after_impact = false;
             ri.since_impact = 0.0;
-            ri.moved();
+            moved(i);
             if (probe) ++probe->interactions, ++probe->held_at_rest;
             return true;
           }
@@ -573,8 +624,9 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
           for (ImpulseRun* r : {&ri, &rj}) {
             r->after_impact = false;
             r->since_impact = 0.0;
-            r->moved();
           }
+          moved(i);
+          moved(j);
           wake(j);
           if (probe) ++probe->interactions;
           return true;
@@ -582,6 +634,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
            *memo);
       }
     }
+    first = limiting;
     if (struck) {
       if (++sweeps == kMaxSweeps) {
         sweeps_capped = true;
@@ -635,6 +688,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         ImpulseRun& r = runs[static_cast<std::size_t>(k)];
         if (r.state != RunState::Running || perched[static_cast<std::size_t>(k)]) continue;
         r.advance(t_end, probe);
+        placed_at[static_cast<std::size_t>(k)] = ++stamp;
       }
       double again = risky_n == 0 ? 1.0 : retry_fraction();
       if (again < 1.0 && tries == kMaxRetries) {  // taken as it is: its overlap is lifted out next, counted if deep
@@ -651,6 +705,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         break;
       }
       std::copy(saved.begin(), saved.end(), runs.begin());
+      for (int k = 0; k < n; ++k) placed_at[static_cast<std::size_t>(k)] = ++stamp;
       window *= again;
       if (probe) ++probe->windows_halved;
     }

@@ -19,8 +19,10 @@ Reach reach_of(ImpulseRun& r, TossProbe* probe) {
   const DieModel& d = *r.m;
   const RigidState& s = r.s;
   const double z_rest = *std::min_element(d.face_height.begin(), d.face_height.end());
-  const double k_rot = 0.5 * s.omega.dot(world_inertia(d, s.R) * s.omega);
-  const double e = kinetic_energy(d, s) + d.mass * d.gravity * std::max(0.0, s.position.z() - z_rest);
+  const Vec3 w_body = s.R.transpose() * s.omega;  // (kinetic_energy's terms, the spin's kept apart)
+  const double k_rot = 0.5 * w_body.dot(d.principal_moments.cwiseProduct(w_body));
+  const double e = 0.5 * d.mass * s.velocity.squaredNorm() + k_rot +
+                   d.mass * d.gravity * std::max(0.0, s.position.z() - z_rest);
   const double i_min = d.principal_moments.minCoeff();
   out.com = 1.05 * std::sqrt(2.0 * e / d.mass) + 1e-12;
   out.any = out.com + 1.05 * d.bounding_radius * std::sqrt(2.0 * e / i_min);
@@ -37,7 +39,9 @@ Reach reach_of(ImpulseRun& r, TossProbe* probe) {
 
 double window_for(double gap, double closing, double accel) {
   if (accel <= 0.0) return closing > 0.0 ? gap / closing : std::numeric_limits<double>::infinity();
-  return 2.0 * gap / (closing + std::sqrt(closing * closing + 2.0 * accel * gap));
+  // The first root of gap - closing t - accel t^2 / 2, each form free of cancellation.
+  const double root = std::sqrt(closing * closing + 2.0 * accel * gap);
+  return closing >= 0.0 ? 2.0 * gap / (closing + root) : (root - closing) / accel;
 }
 
 double spheres_window(const Reach& a, const Reach& b, const Vec3& d, double R) {
@@ -68,15 +72,16 @@ double sphere_fixed_window(const Reach& a, double gap, const Vec3& n, double g) 
   return std::max(dt, a.free_for + std::max(0.0, gap - closed) / a.com);
 }
 
-double closing_time(const DieModel& d, const RigidState& s, const Vec3& n, double level, const RigidState* other) {
+double closing_time(const DieModel& d, std::span<const Vec3> corners, const RigidState& s, const Vec3& n, double level,
+                    const RigidState* other) {
   double soonest = std::numeric_limits<double>::infinity();
-  for (const Vec3& c : d.vertices) {
-    const Vec3 r = s.R * c;
+  for (const Vec3& c : corners) {
+    const Vec3 r = c - s.position;
     Vec3 rel = s.velocity + s.omega.cross(r);
-    if (other) rel -= other->velocity + other->omega.cross(s.position + r - other->position);
+    if (other) rel -= other->velocity + other->omega.cross(c - other->position);
     const double approach = -rel.dot(n);
     if (approach <= 0.0) continue;
-    const double height = std::max(0.0, n.dot(s.position + r) - d.rounding - level);
+    const double height = std::max(0.0, n.dot(c) - d.rounding - level);
     soonest = std::min(soonest, height / approach);
   }
   return soonest;

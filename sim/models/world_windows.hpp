@@ -3,6 +3,8 @@
 // and so how long a pair's gap surely stays open.
 #pragma once
 
+#include <span>
+
 #include "sim/body/die_model.hpp"
 #include "sim/models/impulse_run.hpp"
 #include "sim/models/toss.hpp"
@@ -28,7 +30,8 @@ struct Reach {
 // Die r's reach now (zero: at rest). A run about to fly starts its flight here (its rest check first).
 Reach reach_of(ImpulseRun& r, TossProbe* probe);
 
-// The longest window in which points approaching at `closing` + accel t (m/s) cannot close `gap`.
+// The longest window in which points approaching at `closing` + accel t (m/s) cannot close `gap`
+// (closing < 0: moving apart, until accel turns them; accel >= 0).
 double window_for(double gap, double closing, double accel);
 
 // Bounding spheres: a die stays inside the sphere of its bounding radius about its COM however it
@@ -46,10 +49,12 @@ double spheres_window(const Reach& a, const Reach& b, const Vec3& d, double R);
 // contact, then at the energy bound.
 double sphere_fixed_window(const Reach& a, double gap, const Vec3& n, double g);
 
-// How soon a corner of the die would reach the plane {x : n . x = level} (n pointing into the die)
-// at its velocity now relative to the other body there (`other`'s rigid motion at the corner's
-// place; none: a fixed body): min over corners of height / approach (+inf if none approaches).
-// A far corner approaching fast does not shorten it as a near one does.
-double closing_time(const DieModel& d, const RigidState& s, const Vec3& n, double level, const RigidState* other);
+// How soon a corner of the die (at s, its corners placed in the world: `corners`) would reach the
+// plane {x : n . x = level} (n pointing into the die) at its velocity now relative to the other
+// body there (`other`'s rigid motion at the corner's place; none: a fixed body): min over corners
+// of height / approach (+inf if none approaches). A far corner approaching fast does not shorten
+// it as a near one does.
+double closing_time(const DieModel& d, std::span<const Vec3> corners, const RigidState& s, const Vec3& n, double level,
+                    const RigidState* other);
 
 }  // namespace dicesim::world_detail
