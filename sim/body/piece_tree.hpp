@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <span>
 #include <type_traits>
@@ -24,7 +25,8 @@ class PieceTree {
   // A lower bound on the gap between a sphere and anything inside the box [lo, hi]: the distance
   // from the centre to the box (0 inside it) minus the radius.
   static double box_gap(const Vec3& lo, const Vec3& hi, const Vec3& centre, double radius) {
-    return (lo - centre).cwiseMax(centre - hi).cwiseMax(0.0).norm() - radius;
+    const Vec3 d = (lo - centre).cwiseMax(centre - hi).cwiseMax(0.0);
+    return std::sqrt(d.x() * d.x() + d.y() * d.y() + d.z() * d.z()) - radius;
   }
 
   // Calls f(piece, gap) for every piece whose box_gap(...) `gap` is <= reach, where f returns the

@@ -97,21 +97,6 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   const auto still = [](const ImpulseRun& r) {
     return kinetic_energy(*r.m, r.s) < kStillEnergy * r.m->mass * r.m->gravity * r.m->bounding_radius;
   };
-  // Each die's corners in the world, placed when first needed after the dice last moved (most
-  // pairs are settled by their bounds alone): corners_placed is cleared at each pass (a strike
-  // ends it) and before each check after a window.
-  std::array<bool, kMaxDice> corners_placed{};
-  const auto corners_of = [&](int k) {
-    std::vector<Vec3>& c = corner_buf[static_cast<std::size_t>(k)];
-    if (!corners_placed[static_cast<std::size_t>(k)]) {
-      const DieModel& d = *runs[static_cast<std::size_t>(k)].m;
-      const RigidState& s = runs[static_cast<std::size_t>(k)].s;
-      c.resize(d.vertices.size());
-      for (std::size_t v = 0; v < c.size(); ++v) c[v] = s.position + s.R * d.vertices[v];
-      corners_placed[static_cast<std::size_t>(k)] = true;
-    }
-    return std::span<const Vec3>(c);
-  };
   // Each die's place, stamped: a new stamp whenever it may have moved (a window, a strike's lift,
   // a window taken again). A pair's exact touch is kept with the stamps it was measured at and
   // reused while they hold: a risky pair measured after its window is met again at the next
@@ -121,6 +106,21 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   const auto moved = [&](int k) {
     runs[static_cast<std::size_t>(k)].moved();
     placed_at[static_cast<std::size_t>(k)] = ++stamp;
+  };
+  // Each die's corners in the world, placed when first needed at its stamp (most pairs are settled
+  // by their bounds alone).
+  std::array<std::uint64_t, kMaxDice> corners_at;
+  corners_at.fill(~std::uint64_t{0});
+  const auto corners_of = [&](int k) {
+    std::vector<Vec3>& c = corner_buf[static_cast<std::size_t>(k)];
+    if (corners_at[static_cast<std::size_t>(k)] != placed_at[static_cast<std::size_t>(k)]) {
+      const DieModel& d = *runs[static_cast<std::size_t>(k)].m;
+      const RigidState& s = runs[static_cast<std::size_t>(k)].s;
+      c.resize(d.vertices.size());
+      for (std::size_t v = 0; v < c.size(); ++v) c[v] = s.position + s.R * d.vertices[v];
+      corners_at[static_cast<std::size_t>(k)] = placed_at[static_cast<std::size_t>(k)];
+    }
+    return std::span<const Vec3>(c);
   };
   const auto piece_touch = [&](int i, std::size_t p, PairMemo& memo) -> const Touch& {
     const std::uint64_t at = placed_at[static_cast<std::size_t>(i)];
@@ -186,8 +186,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
       fraction = std::min(fraction, std::clamp(ratio, 0.1, 0.9));
     };
     // A pair's gap along its last normal is a lower bound (axis_gap): no deeper than the sink there,
-    // the pair is not too deep, and GJK need not run. (Corners placed afresh: the dice have moved.)
-    corners_placed.fill(false);
+    // the pair is not too deep, and GJK need not run.
     const auto piece_gap = [&](int i, std::size_t p) {
       PairMemo* memo = memos.piece(i, p);
       const ObstaclePiece& piece = w.pieces[p];
@@ -369,7 +368,6 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         risky(i, j, p, t.gap);
       }
     };
-    corners_placed.fill(false);  // (corners_of: placed once a pass)
     std::uint64_t* witness_only = probe ? &probe->patch_witness_only : nullptr;
     // Two stages: the half-spaces and the other dice first, then the polyhedra through the tree,
     // whose visits a shorter window prunes.
