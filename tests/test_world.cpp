@@ -289,3 +289,19 @@ TEST(World, TheCliTossesAWorldAndShowRefusesIt) {
 }
 
 }  // namespace
+
+// An instant whose strikes reach their cap (16 Gauss-Seidel sweeps over its contacts, slow contacts
+// still approaching, left to the window) is a multi-contact solve not converged: a correction every
+// report carries (pgs_unconverged), not only the bench's probe. The dice tower's wedged dice reach it.
+TEST(World, CappedSweepsAreReportedAsCorrections) {
+  const DieModel m = compile(load_scene(kWorld + "tower-3d6.toml"));
+  std::uint64_t capped = 0, unconverged = 0;
+  for (std::uint64_t i = 0; i < 40; ++i) {
+    TossProbe probe;
+    const TossResult r = toss(m, 20261122, i, &probe);
+    capped += probe.sweeps_capped;
+    unconverged += r.corrections.pgs_unconverged;
+  }
+  ASSERT_GT(capped, 0u);  // the case is met
+  EXPECT_GE(unconverged, capped);
+}

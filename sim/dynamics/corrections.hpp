@@ -13,11 +13,15 @@ namespace dicesim {
 template <class Count>
 struct CorrectionCounts {
   Count energy_clamps = 0;    // an impact would have gained energy and was scaled back
-  Count pgs_unconverged = 0;  // a multi-contact solve converged neither by Gauss-Seidel nor by its Newton finish
+  Count pgs_unconverged = 0;  // a multi-contact solve converged neither by Gauss-Seidel nor by its Newton finish;
+                              // a world toss: an instant's strikes (Gauss-Seidel sweeps over its contacts)
+                              // capped with slow contacts still approaching
   Count overlap_fixes = 0;    // the stepper lifted the die out of the floor
   Count fallbacks = 0;        // a frictionless rescue pass ran (a corner still approaching after the
                               // frictional solve), or corners beyond kMaxContacts got no impulse; an exact
-                              // solve's jam is not one (ImpactResult::exact_fallbacks, reported by bench)
+                              // solve's jam is not one (ImpactResult::exact_fallbacks, reported by bench);
+                              // a world toss: a touch whose contact patch came out empty, struck at its
+                              // nearest point alone
   // The sustained phase's guards (contact_stepper.cpp):
   Count located_capped = 0;          // a new contact not located within the touch tolerance in the trials allowed
   Count support_search_capped = 0;   // curved dice: a support search out of iterations (its end above the floor taken)

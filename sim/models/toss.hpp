@@ -103,10 +103,13 @@ struct TossProbe {
   std::uint64_t interactions = 0;
   std::uint64_t woken = 0;
   std::uint64_t sweeps_capped = 0;  // instants whose strikes reached their cap, slow contacts left touching
+                                    // (also counted: Corrections::pgs_unconverged)
   std::uint64_t held_at_rest = 0;  // slow die-on-die strikes against a die at rest, that die held where it lies
   std::uint64_t patch_witness_only = 0;  // touches whose contact patch came out empty: struck at the witness point alone
+                                         // (also counted: Corrections::fallbacks)
   std::uint64_t perched = 0;  // dice found held still off their rest by fixed bodies (world_toss.cpp: perched)
   std::uint64_t retries_capped = 0;  // risky windows still too deep after kMaxRetries retries, taken as they were
+                                     // (their overlap, lifted out next, is Corrections::contact_overlaps)
   std::uint64_t narrow_degenerate = 0;
   std::uint64_t witness_strikes = 0;  // die-on-obstacle strikes whose nearest point, still approaching after its corners', was struck too
   double max_overlap = 0.0;  // the deepest overlap of two bodies found after a window (m), lifted out

@@ -224,10 +224,14 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   int interactions = 0;
   // Strikes at one instant are Gauss-Seidel sweeps over the contacts there: a die wedged between
   // two bodies may have each slow strike push it into the other for ever. After kMaxSweeps at one
-  // instant its slow contacts are left touching for the window (and its check), counted.
+  // instant its slow contacts are left touching for the window (and its check), counted: a
+  // multi-contact solve not converged (Corrections::pgs_unconverged, and TossProbe::sweeps_capped).
   int sweeps = 0;
   bool sweeps_capped = false;
   std::uint64_t witness_strikes = 0;
+  // Touches whose contact patch came out empty, struck at the witness point alone: a fallback
+  // (Corrections::fallbacks, and TossProbe::patch_witness_only).
+  std::uint64_t witness_only = 0;
   std::array<double, kMaxDice> still_since;  // per die: since when it has been held still off its rest (-1: moving)
   still_since.fill(-1.0);
   // Perched: a still die held where it is by the fixed bodies it touches (obstacles, dice at rest,
@@ -368,7 +372,6 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         risky(i, j, p, t.gap);
       }
     };
-    std::uint64_t* witness_only = probe ? &probe->patch_witness_only : nullptr;
     // Two stages: the half-spaces and the other dice first, then the polyhedra through the tree,
     // whose visits a shorter window prunes.
     for (int stage = 0; stage < 2 && !struck; ++stage)
@@ -432,7 +435,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         };
         consider(t, safe, approach, [&] {
           // Every point of the patch (the witness alone may be any point of a face in contact).
-          const ContactPatch patch = piece_patch(di, corners_of(i), piece, t, sink, witness_only);
+          const ContactPatch patch = piece_patch(di, corners_of(i), piece, t, sink, &witness_only);
           const double un = patch_approach(patch, ri.s, nullptr, t.normal);
           if (!(un < -v_still)) {
             if (!(t.gap < -tol)) return false;
@@ -536,7 +539,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
         };
         consider(t, safe, approach, [&] {
           // Every point of the patch (the witness alone may be any point of a face in contact).
-          const ContactPatch patch = dice_patch(di, corners_of(i), *rj.m, corners_of(j), t, sink, witness_only);
+          const ContactPatch patch = dice_patch(di, corners_of(i), *rj.m, corners_of(j), t, sink, &witness_only);
           int fastest = 0;
           const double un = patch_approach(patch, ri.s, &rj.s, t.normal, &fastest);
           // A die at rest is held by the floor: all the correction goes to the moving one.
@@ -596,7 +599,10 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
                 ri.corrections.add(imp.corrections);
               }
             }
-            if (approaching && probe) ++probe->sweeps_capped;
+            if (approaching) {  // (as an instant's sweeps capped, below)
+              ++ri.corrections.pgs_unconverged;
+              if (probe) ++probe->sweeps_capped;
+            }
           } else {
             // An impact: the one-point law of two bodies at the patch's fastest approaching point.
             const double e = 0.5 * (w.die_restitution[static_cast<std::size_t>(i)] +
@@ -636,6 +642,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     if (struck) {
       if (++sweeps == kMaxSweeps) {
         sweeps_capped = true;
+        ++runs[static_cast<std::size_t>(limiting)].corrections.pgs_unconverged;
         if (probe) ++probe->sweeps_capped;
       }
       if (++interactions > kMaxInteractions) unresolved = true;
@@ -713,6 +720,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   if (probe) {
     probe->windows += windows;
     probe->witness_strikes += witness_strikes;
+    probe->patch_witness_only += witness_only;
   }
 
   // The toss's result from every die's.
@@ -728,6 +736,7 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     if (one.status != TossStatus::Settled) unresolved = true;
     else tuple += one.outcome * w.stride[static_cast<std::size_t>(k)];
   }
+  res.corrections.fallbacks += static_cast<std::uint32_t>(witness_only);
   if (unresolved) {
     res.status = TossStatus::Unresolved;
     return res;
