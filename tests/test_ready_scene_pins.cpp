@@ -185,7 +185,7 @@ TEST(ReadyScenes, WorldCountsArePinned) {
       {"scenes/world/loaded-pair.toml", Fidelity::Impulse, 200, {6, 4, 3, 4, 4, 7, 8, 6, 9, 3, 2, 10, 7, 3, 7, 3, 5, 15, 6, 5, 6, 5, 6, 4, 3, 6, 4, 8, 9, 6, 3, 5, 4, 5, 4, 2}, 4599, 3, 0, {0, 0, 0, 0}},
       {"scenes/world/craps.toml", Fidelity::Impulse, 100, {2, 6, 10, 10, 17, 17, 13, 10, 9, 5, 1}, 3153, 0, 0, {0, 0, 0, 0}},
       {"scenes/world/craps-controlled.toml", Fidelity::Impulse, 100, {0, 3, 0, 3, 0, 1, 2, 10, 6, 8, 2, 5, 1, 6, 1, 4, 2, 2, 1, 5, 1, 1, 3, 2, 1, 0, 4, 6, 4, 1, 1, 3, 6, 1, 3, 1}, 2831, 0, 0, {0, 0, 0, 0}},
-      {"scenes/world/tower-3d6.toml", Fidelity::Impulse, 40, {0, 0, 2, 1, 5, 6, 3, 5, 5, 4, 4, 0, 1, 2, 1, 0}, 3344, 1, 0, {0, 3, 0, 0}},
+      {"scenes/world/tower-3d6.toml", Fidelity::Impulse, 40, {0, 0, 2, 1, 6, 5, 3, 6, 3, 5, 4, 0, 1, 2, 1, 0}, 3341, 1, 0, {0, 3, 0, 0}},
   };
   for (const Pin& p : pins) check(p);
 }

@@ -305,3 +305,14 @@ TEST(World, CappedSweepsAreReportedAsCorrections) {
   ASSERT_GT(capped, 0u);  // the case is met
   EXPECT_GE(unconverged, capped);
 }
+
+// After a patch's solve the witness point is struck on its own only if it still approaches by more
+// than rounding (1e-10 of the speeds involved, as the floor's law allows). At zero, every tray toss
+// struck ~2 witness points approaching at 1e-16 to 1e-14 of the speeds: noise, counted as strikes.
+TEST(World, WitnessStrikesAreApproachesNotRounding) {
+  const DieModel m = compile(load_scene(kWorld + "tray-2d6.toml"));
+  TossProbe probe;
+  for (std::uint64_t i = 0; i < 100; ++i) toss(m, 20261122, i, &probe);
+  ASSERT_GT(probe.interactions, 500u);  // the dice strike the tray and each other
+  EXPECT_LE(probe.witness_strikes, 5u);
+}

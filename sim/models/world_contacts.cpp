@@ -122,6 +122,10 @@ ImpactResult strike_fixed(const DieModel& d, RigidState& s, const Touch& t, cons
     r[static_cast<std::size_t>(c.n++)] = Q * (patch.points[static_cast<std::size_t>(q)] - s.position);
   }
   RigidState q{Q * s.position, Q * s.velocity, Q * s.R, Q * s.omega};
+  // The speeds involved, as the floor's law takes them (friction_impact.cpp): the witness point
+  // approaching by less than 1e-10 of them after the patch's solve is rounding, not approach.
+  const double speed =
+      s.velocity.norm() + s.omega.norm() * d.bounding_radius + 1e-2 * std::sqrt(d.gravity * d.bounding_radius);
   ContactImpulses warm, out;
   warm.n = restitution ? 0 : memo.warm_n;  // (a stale start that would add energy is dropped by the law)
   for (int k = 0; k < warm.n; ++k) {
@@ -132,7 +136,7 @@ ImpactResult strike_fixed(const DieModel& d, RigidState& s, const Touch& t, cons
   memo.warm_n = std::min(out.n, static_cast<int>(memo.warm.size()));
   for (int k = 0; k < memo.warm_n; ++k) memo.warm[static_cast<std::size_t>(k)] = out.P[k];
   const Vec3 w_point = Q * (t.point - s.position);
-  if ((q.velocity + q.omega.cross(w_point)).z() < 0.0) {
+  if ((q.velocity + q.omega.cross(w_point)).z() < -1e-10 * speed) {
     ContactSet one;
     one.n = 1;
     one.vertex[0] = 0;

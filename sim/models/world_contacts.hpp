@@ -136,8 +136,9 @@ double patch_approach(const ContactPatch& patch, const RigidState& si, const Rig
 
 // Die i against a fixed body (an obstacle, or a die held at rest) over a contact patch: the floor's
 // law turned to the touch's normal, every point of the patch together. `d` carries the pair's
-// materials. If the patch's solve leaves the witness point approaching, that point is struck on
-// its own too (counted in `witness`).
+// materials. If the patch's solve leaves the witness point approaching (by more than 1e-10 of the
+// speeds involved, the floor law's allowance for rounding), that point is struck on its own too
+// (counted in `witness`).
 ImpactResult strike_fixed(const DieModel& d, RigidState& s, const Touch& t, const ContactPatch& patch,
                           bool restitution, std::uint64_t& witness, PairMemo& memo);
 
