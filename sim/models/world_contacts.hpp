@@ -46,9 +46,9 @@ struct PairMemo {
   // struck at the same points window after window.
   std::array<Vec3, 4> warm{};  // a patch has at most four points
   int warm_n = 0;
-  // The last exact touch, and the stamps of the dice's places it was measured at (run_world).
+  // The last exact touch, and the stamps of the dice's places it was measured at (run_world's
+  // stamps start at 1: 0, none; a piece's j stays 0).
   Touch touch;
-  bool measured = false;
   std::uint64_t measured_i = 0, measured_j = 0;
 };
 

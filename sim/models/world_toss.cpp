@@ -105,8 +105,10 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
   // a window taken again). A pair's exact touch is kept with the stamps it was measured at and
   // reused while they hold: a risky pair measured after its window is met again at the next
   // pass, and a strike elsewhere leaves the other dice's pairs as they were.
+  // (Stamps start at 1: a fresh memo's 0 was measured at none.)
   std::array<std::uint64_t, kMaxDice> placed_at{};
   std::uint64_t stamp = 0;
+  for (int k = 0; k < n; ++k) placed_at[static_cast<std::size_t>(k)] = ++stamp;
   const auto moved = [&](int k) {
     runs[static_cast<std::size_t>(k)].moved();
     placed_at[static_cast<std::size_t>(k)] = ++stamp;
@@ -126,24 +128,26 @@ TossResult run_world(const DieModel& m, const std::vector<RigidState>& starts, c
     }
     return std::span<const Vec3>(c);
   };
-  const auto piece_touch = [&](int i, std::size_t p, PairMemo& memo) -> const Touch& {
-    const std::uint64_t at = placed_at[static_cast<std::size_t>(i)];
-    if (!(memo.measured && memo.measured_i == at)) {
-      memo.touch = touch_piece(w, i, runs[static_cast<std::size_t>(i)].s, w.pieces[p], &memo.sep);
-      memo.measured = true;
-      memo.measured_i = at;
-    }
-    return memo.touch;
-  };
-  const auto die_touch = [&](int i, int j, PairMemo& memo) -> const Touch& {
-    const std::uint64_t at_i = placed_at[static_cast<std::size_t>(i)], at_j = placed_at[static_cast<std::size_t>(j)];
-    if (!(memo.measured && memo.measured_i == at_i && memo.measured_j == at_j)) {
-      memo.touch = touch_die(w, i, runs[static_cast<std::size_t>(i)].s, j, runs[static_cast<std::size_t>(j)].s, &memo.sep);
-      memo.measured = true;
+  // A pair's exact touch where its bodies are now (j < 0: a piece, which never moves): the memo's,
+  // if measured at these places, else measured.
+  const auto touch_now = [&](PairMemo& memo, int i, int j, auto&& measure) -> const Touch& {
+    const std::uint64_t at_i = placed_at[static_cast<std::size_t>(i)];
+    const std::uint64_t at_j = j < 0 ? 0 : placed_at[static_cast<std::size_t>(j)];
+    if (memo.measured_i != at_i || memo.measured_j != at_j) {
+      memo.touch = measure();
       memo.measured_i = at_i;
       memo.measured_j = at_j;
     }
     return memo.touch;
+  };
+  const auto piece_touch = [&](int i, std::size_t p, PairMemo& memo) -> const Touch& {
+    return touch_now(memo, i, -1,
+                     [&] { return touch_piece(w, i, runs[static_cast<std::size_t>(i)].s, w.pieces[p], &memo.sep); });
+  };
+  const auto die_touch = [&](int i, int j, PairMemo& memo) -> const Touch& {
+    return touch_now(memo, i, j, [&] {
+      return touch_die(w, i, runs[static_cast<std::size_t>(i)].s, j, runs[static_cast<std::size_t>(j)].s, &memo.sep);
+    });
   };
 
   // The start must be possible: no die inside another or inside an obstacle. (Of the polyhedra,
